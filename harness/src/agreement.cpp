@@ -1,0 +1,47 @@
+#include "agreement.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace raybench {
+
+Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference) {
+  Agreement a;
+  a.has_prims = true;
+  a.rays = tested.size();
+  std::vector<double> relerr;
+  for (std::size_t i = 0; i < tested.size(); ++i) {
+    const Hit& t = tested[i];
+    const Hit& r = reference[i];
+    a.hits += t.hit();
+    if (t.hit() != r.hit()) continue;
+    ++a.same_hit;
+    if (!t.hit()) continue;
+    ++a.both_hit;
+    if (t.prim == r.prim) ++a.same_prim;
+    else if (t.t == r.t) ++a.prim_ties;
+    const double diff = std::fabs(static_cast<double>(t.t) - r.t);
+    relerr.push_back(r.t != 0.0f ? diff / std::fabs(static_cast<double>(r.t)) : diff);
+  }
+  if (!relerr.empty()) {
+    // Nearest-rank percentile: the smallest value with at least 99.9 % at or below it.
+    const auto rank = static_cast<std::size_t>(std::ceil(0.999 * relerr.size())) - 1;
+    std::nth_element(relerr.begin(), relerr.begin() + rank, relerr.end());
+    a.t_relerr_p999 = relerr[rank];
+    a.t_relerr_max = *std::max_element(relerr.begin(), relerr.end());
+  }
+  return a;
+}
+
+Agreement compare_occlusion(std::span<const std::uint8_t> tested, std::span<const std::uint8_t> reference) {
+  Agreement a;
+  a.rays = tested.size();
+  for (std::size_t i = 0; i < tested.size(); ++i) {
+    a.hits += tested[i] != 0;
+    a.same_hit += (tested[i] != 0) == (reference[i] != 0);
+  }
+  return a;
+}
+
+}  // namespace raybench

@@ -1,0 +1,33 @@
+// Per-ray agreement of a backend with a reference (Embree's default build).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "raybench/math/ray.h"
+
+namespace raybench {
+
+struct Agreement {
+  std::size_t rays = 0;
+  std::size_t hits = 0;            // rays the tested backend reports as hit/occluded
+  std::size_t same_hit = 0;        // rays where both agree on hit or miss
+  std::size_t both_hit = 0;        // closest-hit queries only
+  std::size_t same_prim = 0;       // of both_hit, the same triangle
+  std::size_t prim_ties = 0;       // of both_hit, another triangle at exactly the same t
+  double t_relerr_max = 0.0;       // over both_hit: |t - t_ref| / |t_ref|
+  double t_relerr_p999 = 0.0;      // 99.9th percentile of the same
+  bool has_prims = false;          // false for occlusion queries: no prim or t to compare
+
+  double hit_rate() const { return rays ? static_cast<double>(hits) / rays : 0.0; }
+  double agree_hit() const { return rays ? static_cast<double>(same_hit) / rays : 1.0; }
+  double agree_prim() const { return both_hit ? static_cast<double>(same_prim) / both_hit : 1.0; }
+  // Rays that disagree on hit/miss, plus rays where both hit different triangles.
+  std::size_t disagreements() const { return (rays - same_hit) + (both_hit - same_prim); }
+};
+
+Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference);
+Agreement compare_occlusion(std::span<const std::uint8_t> tested, std::span<const std::uint8_t> reference);
+
+}  // namespace raybench

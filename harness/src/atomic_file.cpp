@@ -1,0 +1,47 @@
+#include "atomic_file.h"
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <unistd.h>
+
+#include "error.h"
+
+namespace raybench {
+
+void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write,
+                           std::ios::openmode mode) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  std::error_code ec;
+  if (target.has_parent_path() && !fs::exists(target.parent_path(), ec)) {
+    fs::create_directories(target.parent_path(), ec);
+    if (ec) throw InputError(path, "cannot create directory " + target.parent_path().string() + ": " + ec.message());
+  }
+  if (fs::is_directory(target, ec)) throw InputError(path, "is a directory");
+  const std::string temp = path + ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(temp, mode | std::ios::trunc);
+    if (!out) throw InputError(path, std::string("cannot be written: ") + std::strerror(errno));
+    try {
+      write(out);
+    } catch (...) {
+      out.close();
+      fs::remove(temp, ec);
+      throw;
+    }
+    out.flush();
+    if (!out) {
+      out.close();
+      fs::remove(temp, ec);
+      throw InputError(path, "write failed (disk full?)");
+    }
+  }
+  fs::rename(temp, target, ec);
+  if (ec) {
+    fs::remove(temp, ec);
+    throw InputError(path, "cannot be replaced: " + ec.message());
+  }
+}
+
+}  // namespace raybench

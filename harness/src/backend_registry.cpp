@@ -1,0 +1,55 @@
+#include <functional>
+
+#include <fmt/format.h>
+
+#include "backend.h"
+#include "backends/backend_families.h"
+#include "error.h"
+
+namespace raybench {
+namespace {
+
+struct Family {
+  std::string name;
+  std::function<std::unique_ptr<Backend>(const std::string&, const std::vector<std::string>&, const BackendConfig&)> make;
+  std::function<std::vector<BackendInfo>()> names;
+};
+
+// The one list of backend families.
+const std::vector<Family>& families() {
+  static const std::vector<Family> list = {
+      {"embree", make_embree_backend, embree_backend_names},
+      {"bvh2", make_bvh2_backend, bvh2_backend_names},
+  };
+  return list;
+}
+
+}  // namespace
+
+std::unique_ptr<Backend> make_backend(const std::string& name, const BackendConfig& config) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t colon = name.find(':', start);
+    parts.push_back(name.substr(start, colon - start));
+    if (colon == std::string::npos) break;
+    start = colon + 1;
+  }
+  for (const Family& f : families()) {
+    if (f.name == parts[0]) return f.make(name, {parts.begin() + 1, parts.end()}, config);
+  }
+  std::string known;
+  for (const Family& f : families()) known += (known.empty() ? "" : ", ") + f.name;
+  throw InputError("", fmt::format("unknown backend '{}' (known families: {}; see 'raybench backends')", name, known));
+}
+
+std::vector<BackendInfo> list_backends() {
+  std::vector<BackendInfo> out;
+  for (const Family& f : families()) {
+    auto names = f.names();
+    out.insert(out.end(), names.begin(), names.end());
+  }
+  return out;
+}
+
+}  // namespace raybench

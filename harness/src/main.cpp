@@ -1,0 +1,248 @@
+// raybench: how fast is a ray-tracing kernel, and how often is it wrong, next
+// to Embree, on real meshes and the same rays. See README.md.
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "agreement.h"
+#include "build_info.h"
+#include "backend.h"
+#include "error.h"
+#include "metadata.h"
+#include "npy.h"
+#include "procedural.h"
+#include "rayset.h"
+#include "scene.h"
+#include "suite.h"
+#include "suite_run.h"
+#include "trace.h"
+
+namespace raybench {
+namespace {
+
+const std::string kDefaultSuite = std::string(RAYBENCH_SOURCE_DIR) + "/meshes/default.toml";
+const std::string kDefaultOut = std::string(RAYBENCH_SOURCE_DIR) + "/results/latest.csv";
+const std::string kDefaultRaysDir = std::string(RAYBENCH_SOURCE_DIR) + "/results/rays";
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& e : v) s += (s.empty() ? "" : ", ") + e;
+  return s;
+}
+
+// A scene argument is a suite scene's name or a mesh path / proc: spec.
+struct SceneArg {
+  Scene scene;
+  const SuiteScene* entry = nullptr;
+};
+
+SceneArg resolve_scene(const std::string& arg, const Suite* suite) {
+  SceneArg out;
+  out.entry = suite ? suite->find(arg) : nullptr;
+  out.scene = load_scene(out.entry ? out.entry->path : arg);
+  if (out.entry) out.scene.name = out.entry->name;
+  return out;
+}
+
+// The default suite is read only when a command needs a scene name from it;
+// a broken or absent default manifest must not stop `trace FILE`.
+const Suite* suite_if_readable(const std::string& path, bool explicit_path, Suite& storage) {
+  try {
+    storage = load_suite(path);
+    return &storage;
+  } catch (const InputError&) {
+    if (explicit_path) throw;
+    return nullptr;
+  }
+}
+
+std::string command_line(int argc, char** argv) {
+  std::string s;
+  for (int i = 0; i < argc; ++i) s += (i ? " " : "") + std::string(argv[i]);
+  return s;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{"raybench: throughput and per-ray agreement of ray-tracing kernels against Embree, on the same rays.\n"
+               "Exit status: 0 success, 2 bad usage or input."};
+  app.require_subcommand(1);
+  app.set_help_all_flag("--help-all", "Show help for every command");
+
+  // raybench run
+  RunOptions run_options;
+  std::string suite_path = kDefaultSuite;
+  std::vector<std::string> run_raysets, run_backends;
+  std::vector<int> run_threads;
+  std::size_t run_rays = 0;
+  int run_reps = 0, run_build_reps = -1;
+  std::uint64_t run_seed = 0;
+  double run_min_time = -1, run_warmup = -1;
+  bool no_interleave = false, list_only = false;
+  run_options.out_csv = kDefaultOut;
+  run_options.rays_dir = kDefaultRaysDir;
+  CLI::App* run_cmd = app.add_subcommand("run", "Run a benchmark suite: every scene x ray set x backend x thread count");
+  run_cmd->add_option("--suite", suite_path, "Suite manifest (TOML)")->capture_default_str();
+  run_cmd->add_option("--scene,-s", run_options.scenes,
+                      "Scenes to run: names from the suite, mesh paths, or proc:<name> (default: every available suite scene)")
+      ->delimiter(',');
+  run_cmd->add_option("--rayset,-r", run_raysets, "Ray sets: " + join(rayset_kind_names()) + " (default: the suite's)")
+      ->delimiter(',');
+  run_cmd->add_option("--rays,-n", run_rays, "Rays per ray set (default: the suite's, 262144)");
+  run_cmd->add_option("--backend,-b", run_backends, "Backends, e.g. embree,embree:high,bvh2 (see 'raybench backends')")
+      ->delimiter(',');
+  run_cmd->add_option("--threads,-t", run_threads, "Thread counts, e.g. 1,2 (default: 1)")->delimiter(',')->check(CLI::PositiveNumber);
+  run_cmd->add_option("--reps", run_reps, "Timed repetitions per case; the median is reported (default: 5)")->check(CLI::PositiveNumber);
+  run_cmd->add_option("--build-reps", run_build_reps, "Timed builds per backend (default: 3)")->check(CLI::PositiveNumber);
+  run_cmd->add_option("--seed", run_seed, "Ray generation seed (default: 1)");
+  run_cmd->add_option("--min-time", run_min_time, "Minimum seconds per repetition (default: 0.05)")->check(CLI::PositiveNumber);
+  run_cmd->add_option("--warmup", run_warmup, "Untimed warm-up seconds per case (default: 0.05)")->check(CLI::NonNegativeNumber);
+  run_cmd->add_option("--out,-o", run_options.out_csv, "Results CSV; metadata goes beside it as .meta.toml")->capture_default_str();
+  run_cmd->add_option("--rays-dir", run_options.rays_dir, "Where ray sets are stored and reused")->capture_default_str();
+  run_cmd->add_flag("--no-interleave", no_interleave, "Run each case's repetitions back to back instead of interleaved");
+  run_cmd->add_flag("--list", list_only, "List the suite's scenes and whether they are available, then exit");
+
+  // raybench rays
+  std::string rays_scene, rays_kind = "primary", rays_out, rays_suite = kDefaultSuite;
+  std::size_t rays_count = 262144;
+  std::uint64_t rays_seed = 1;
+  CLI::App* rays_cmd = app.add_subcommand("rays", "Generate a ray set and store it as .npy, float32 (N, 8): ox oy oz tnear dx dy dz tfar");
+  rays_cmd->add_option("--scene,-s", rays_scene, "Mesh path, proc:<name>, or a suite scene name (uses its camera)")->required();
+  rays_cmd->add_option("--kind,-k", rays_kind, "Ray set: " + join(rayset_kind_names()))->capture_default_str();
+  rays_cmd->add_option("--count,-n", rays_count, "Number of rays")->capture_default_str()->check(CLI::PositiveNumber);
+  rays_cmd->add_option("--seed", rays_seed, "Seed")->capture_default_str();
+  rays_cmd->add_option("--suite", rays_suite, "Suite manifest to look scene names up in")->capture_default_str();
+  rays_cmd->add_option("--out,-o", rays_out, "Output .npy file")->required();
+
+  // raybench trace
+  std::string trace_scene, trace_rays, trace_backend = "bvh2", trace_out, trace_suite = kDefaultSuite;
+  bool trace_occluded = false;
+  int trace_threads = 1;
+  CLI::App* trace_cmd = app.add_subcommand(
+      "trace", "Trace a ray file with one backend and write hits as .npy, float64 (N, 4): t prim u v (t=inf, prim=-1 on a miss)");
+  trace_cmd->add_option("--scene,-s", trace_scene, "Mesh path, proc:<name>, or a suite scene name")->required();
+  trace_cmd->add_option("--rays", trace_rays, "Ray file (.npy, float32, shape (N, 8))")->required();
+  trace_cmd->add_option("--backend,-b", trace_backend, "Backend name (see 'raybench backends')")->capture_default_str();
+  trace_cmd->add_option("--out,-o", trace_out, "Output .npy file")->required();
+  trace_cmd->add_flag("--occluded", trace_occluded,
+                      "Any-hit occlusion query instead of closest hit; writes float64 (N, 1): 1 occluded, 0 not");
+  trace_cmd->add_option("--threads,-t", trace_threads, "Threads")->capture_default_str()->check(CLI::PositiveNumber);
+  trace_cmd->add_option("--suite", trace_suite, "Suite manifest to look scene names up in")->capture_default_str();
+
+  // raybench backends / scenes
+  CLI::App* backends_cmd = app.add_subcommand("backends", "List backend names");
+  std::string scenes_suite = kDefaultSuite;
+  CLI::App* scenes_cmd = app.add_subcommand("scenes", "List the suite's scenes and the procedural scenes");
+  scenes_cmd->add_option("--suite", scenes_suite, "Suite manifest")->capture_default_str();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "raybench: error: " << e.what() << " (see 'raybench --help')" << std::endl;
+    return 2;
+  }
+
+  if (*backends_cmd) {
+    for (const BackendInfo& b : list_backends()) fmt::print("{:<20} {}\n", b.name, b.description);
+    return 0;
+  }
+  if (*scenes_cmd || (*run_cmd && list_only)) {
+    const Suite suite = load_suite(*scenes_cmd ? scenes_suite : suite_path);
+    fmt::print("suite {}:\n", suite.path);
+    for (const SuiteScene& s : suite.scenes)
+      fmt::print("  {:<18} {:<9} {}\n", s.name, s.available() ? "available" : "missing", s.path);
+    fmt::print("procedural scenes (use as proc:<name>):\n");
+    for (const ProceduralSceneInfo& p : procedural_scenes()) fmt::print("  {:<22} {}\n", p.name, p.description);
+    return 0;
+  }
+  if (*run_cmd) {
+    run_options.suite = load_suite(suite_path);
+    SuiteSettings& s = run_options.settings;
+    s = run_options.suite.settings;
+    if (!run_raysets.empty()) s.raysets = run_raysets;
+    if (!run_backends.empty()) s.backends = run_backends;
+    if (!run_threads.empty()) s.threads = run_threads;
+    if (run_rays) s.rays = run_rays;
+    if (run_reps) s.repetitions = run_reps;
+    if (run_build_reps > 0) s.build_repetitions = run_build_reps;
+    if (run_cmd->count("--seed")) s.seed = run_seed;
+    if (run_min_time > 0) s.min_time = run_min_time;
+    if (run_warmup >= 0) s.warmup = run_warmup;
+    run_options.interleave = !no_interleave;
+    run_options.command_line = command_line(argc, argv);
+    const std::vector<ResultRow> rows = run_suite(run_options);
+    std::cout << format_results_table(rows) << std::endl;
+    fmt::print("results: {} ({} rows), metadata: {}\n", run_options.out_csv, rows.size(),
+               metadata_path_for(run_options.out_csv));
+    return 0;
+  }
+  if (*rays_cmd) {
+    Suite storage;
+    const Suite* suite = suite_if_readable(rays_suite, rays_cmd->count("--suite") > 0, storage);
+    const RaySetKind kind = parse_rayset_kind(rays_kind);
+    const SceneArg s = resolve_scene(rays_scene, suite);
+    const RayGenerator generator(s.scene);
+    RaySetSpec spec{kind, rays_count, rays_seed, s.entry ? s.entry->camera : std::nullopt,
+                    s.entry ? s.entry->light : std::nullopt};
+    const std::vector<Ray> rays = generator.generate(spec);
+    write_ray_file(rays_out, rays);
+    fmt::print("wrote {} {} rays for {} ({} triangles) to {}\n", rays.size(), rays_kind, s.scene.name,
+               s.scene.triangles.size(), rays_out);
+    return 0;
+  }
+  if (*trace_cmd) {
+    Suite storage;
+    const Suite* suite = suite_if_readable(trace_suite, trace_cmd->count("--suite") > 0, storage);
+    std::unique_ptr<Backend> backend = make_backend(trace_backend, {trace_threads});
+    const std::vector<Ray> rays = read_ray_file(trace_rays);
+    const SceneArg s = resolve_scene(trace_scene, suite);
+    const TraceExecutor executor(trace_threads);
+    executor.run([&] { backend->build(s.scene); });
+    std::size_t hits = 0;
+    if (trace_occluded) {
+      std::vector<std::uint8_t> occ(rays.size());
+      executor.occluded(*backend, rays, occ);
+      std::vector<double> out(occ.begin(), occ.end());
+      for (std::uint8_t o : occ) hits += o;
+      write_npy_f64(trace_out, out, rays.size(), 1);
+      fmt::print("occlusion query: {} of {} rays occluded; wrote (N, 1) occlusion flags (not hit records) to {}\n", hits,
+                 rays.size(), trace_out);
+    } else {
+      std::vector<Hit> h(rays.size());
+      executor.intersect(*backend, rays, h);
+      std::vector<double> out(rays.size() * 4);
+      for (std::size_t i = 0; i < h.size(); ++i) {
+        out[4 * i + 0] = h[i].t;
+        out[4 * i + 1] = h[i].prim;
+        out[4 * i + 2] = h[i].hit() ? h[i].u : 0.0;
+        out[4 * i + 3] = h[i].hit() ? h[i].v : 0.0;
+        hits += h[i].hit();
+      }
+      write_npy_f64(trace_out, out, rays.size(), 4);
+      fmt::print("closest hit: {} of {} rays hit; wrote (N, 4) t prim u v to {}\n", hits, rays.size(), trace_out);
+    }
+    return 0;
+  }
+  return 2;
+}
+
+}  // namespace
+}  // namespace raybench
+
+int main(int argc, char** argv) {
+  try {
+    return raybench::run(argc, argv);
+  } catch (const raybench::InputError& e) {
+    std::cerr << "raybench: error: " << e.what() << std::endl;
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "raybench: error: out of memory" << std::endl;
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "raybench: error: " << e.what() << std::endl;
+    return 2;
+  }
+}

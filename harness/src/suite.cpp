@@ -1,0 +1,175 @@
+#include "suite.h"
+
+#include <filesystem>
+#include <set>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "error.h"
+#include "procedural.h"
+
+namespace raybench {
+namespace {
+
+class Reader {
+ public:
+  explicit Reader(std::string path) : path_(std::move(path)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& problem) const {
+    throw InputError(path_, fmt::format("'{}': {}", key, problem));
+  }
+
+  void check_keys(const toml::table& table, const std::string& where, std::set<std::string> allowed) const {
+    for (const auto& [key, value] : table) {
+      if (!allowed.count(std::string(key.str())))
+        fail(where.empty() ? std::string(key.str()) : where + "." + std::string(key.str()), "unknown key");
+    }
+  }
+
+  template <typename T>
+  T get(const toml::table& table, const std::string& where, const char* key, T fallback) const {
+    const toml::node* node = table.get(key);
+    if (!node) return fallback;
+    if constexpr (std::is_same_v<T, std::string>) {
+      if (auto v = node->value<std::string>()) return *v;
+      fail(where + key, "expected a string");
+    } else if constexpr (std::is_same_v<T, bool>) {
+      if (auto v = node->value<bool>()) return *v;
+      fail(where + key, "expected true or false");
+    } else if constexpr (std::is_floating_point_v<T>) {
+      if (auto v = node->value<double>()) return static_cast<T>(*v);
+      fail(where + key, "expected a number");
+    } else {
+      if (auto v = node->value<std::int64_t>(); v && *v >= 0) return static_cast<T>(*v);
+      fail(where + key, "expected a non-negative integer");
+    }
+  }
+
+  std::vector<std::string> strings(const toml::table& table, const std::string& where, const char* key,
+                                   std::vector<std::string> fallback) const {
+    const toml::node* node = table.get(key);
+    if (!node) return fallback;
+    const toml::array* array = node->as_array();
+    if (!array) fail(where + key, "expected an array of strings");
+    std::vector<std::string> out;
+    for (const toml::node& e : *array) {
+      auto v = e.value<std::string>();
+      if (!v) fail(where + key, "expected an array of strings");
+      out.push_back(*v);
+    }
+    return out;
+  }
+
+  Vec3f vec3(const toml::node& node, const std::string& key) const {
+    const toml::array* array = node.as_array();
+    if (!array || array->size() != 3) fail(key, "expected [x, y, z]");
+    Vec3f v;
+    for (int i = 0; i < 3; ++i) {
+      auto c = (*array)[static_cast<std::size_t>(i)].value<double>();
+      if (!c) fail(key, "expected [x, y, z] numbers");
+      v[i] = static_cast<float>(*c);
+    }
+    return v;
+  }
+
+  Camera camera(const toml::node& node, const std::string& key) const {
+    const toml::table* t = node.as_table();
+    if (!t) fail(key, "expected a table { position = [..], look_at = [..], up = [..], fov = deg }");
+    check_keys(*t, key, {"position", "look_at", "up", "fov"});
+    Camera c;
+    if (!t->get("position") || !t->get("look_at")) fail(key, "needs position and look_at");
+    c.position = vec3(*t->get("position"), key + ".position");
+    c.look_at = vec3(*t->get("look_at"), key + ".look_at");
+    if (t->get("up")) c.up = vec3(*t->get("up"), key + ".up");
+    c.fov_degrees = get<float>(*t, key + ".", "fov", c.fov_degrees);
+    if (!(c.fov_degrees > 0.0f && c.fov_degrees < 180.0f)) fail(key + ".fov", "must be in (0, 180) degrees");
+    return c;
+  }
+
+ private:
+  std::string path_;
+};
+
+}  // namespace
+
+bool SuiteScene::available() const {
+  if (path.rfind(kProceduralPrefix, 0) == 0) return true;
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
+
+const SuiteScene* Suite::find(const std::string& name) const {
+  for (const SuiteScene& s : scenes)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+Suite load_suite(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw InputError(path, "no such suite manifest");
+  toml::table root;
+  try {
+    root = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    throw InputError(path, fmt::format("line {}: {}", e.source().begin.line, e.description()));
+  }
+  const Reader r(path);
+  r.check_keys(root, "", {"defaults", "scene"});
+  Suite suite;
+  suite.path = path;
+  SuiteSettings& s = suite.settings;
+  if (const toml::node* d = root.get("defaults")) {
+    const toml::table* t = d->as_table();
+    if (!t) r.fail("defaults", "expected a table");
+    r.check_keys(*t, "defaults", {"rays", "raysets", "backends", "threads", "repetitions", "build_repetitions", "seed",
+                                  "min_time", "warmup"});
+    s.rays = r.get<std::size_t>(*t, "defaults.", "rays", s.rays);
+    s.raysets = r.strings(*t, "defaults.", "raysets", s.raysets);
+    for (const std::string& k : s.raysets) parse_rayset_kind(k);
+    s.backends = r.strings(*t, "defaults.", "backends", s.backends);
+    if (const toml::node* th = t->get("threads")) {
+      const toml::array* a = th->as_array();
+      if (!a || a->empty()) r.fail("defaults.threads", "expected an array of thread counts, e.g. [1, 2]");
+      s.threads.clear();
+      for (const toml::node& e : *a) {
+        auto v = e.value<std::int64_t>();
+        if (!v || *v < 1) r.fail("defaults.threads", "thread counts must be integers >= 1");
+        s.threads.push_back(static_cast<int>(*v));
+      }
+    }
+    s.repetitions = r.get<int>(*t, "defaults.", "repetitions", s.repetitions);
+    s.build_repetitions = r.get<int>(*t, "defaults.", "build_repetitions", s.build_repetitions);
+    s.seed = r.get<std::uint64_t>(*t, "defaults.", "seed", s.seed);
+    s.min_time = r.get<double>(*t, "defaults.", "min_time", s.min_time);
+    s.warmup = r.get<double>(*t, "defaults.", "warmup", s.warmup);
+  }
+  const fs::path base = fs::path(path).parent_path();
+  if (const toml::node* scenes = root.get("scene")) {
+    const toml::array* a = scenes->as_array();
+    if (!a) r.fail("scene", "expected [[scene]] tables");
+    std::size_t index = 0;
+    for (const toml::node& e : *a) {
+      const std::string key = fmt::format("scene[{}]", index++);
+      const toml::table* t = e.as_table();
+      if (!t) r.fail(key, "expected a table");
+      r.check_keys(*t, key, {"name", "path", "optional", "camera", "light", "note"});
+      SuiteScene scene;
+      scene.name = r.get<std::string>(*t, key + ".", "name", "");
+      scene.path = r.get<std::string>(*t, key + ".", "path", "");
+      if (scene.name.empty() || scene.path.empty()) r.fail(key, "needs a name and a path");
+      if (suite.find(scene.name)) r.fail(key + ".name", "duplicate scene name '" + scene.name + "'");
+      if (scene.path.rfind(kProceduralPrefix, 0) != 0 && fs::path(scene.path).is_relative())
+        scene.path = (base / scene.path).lexically_normal().string();
+      scene.optional = r.get<bool>(*t, key + ".", "optional", false);
+      if (const toml::node* c = t->get("camera")) scene.camera = r.camera(*c, key + ".camera");
+      if (const toml::node* l = t->get("light")) scene.light = r.vec3(*l, key + ".light");
+      suite.scenes.push_back(std::move(scene));
+    }
+  }
+  if (suite.scenes.empty()) throw InputError(path, "the suite names no [[scene]]");
+  return suite;
+}
+
+}  // namespace raybench

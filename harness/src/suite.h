@@ -1,0 +1,49 @@
+// A suite manifest (TOML, e.g. meshes/default.toml): which scenes, ray sets,
+// backends and settings a run uses. See README.md, "Suite manifests".
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rayset.h"
+
+namespace raybench {
+
+struct SuiteScene {
+  std::string name;  // used in results and on the command line
+  std::string path;  // resolved against the manifest's folder; or "proc:<name>"
+  bool optional = false;  // skipped with a note when the file is absent
+  std::optional<Camera> camera;
+  std::optional<Vec3f> light;
+
+  bool available() const;
+};
+
+struct SuiteSettings {
+  std::size_t rays = 262144;
+  std::vector<std::string> raysets{"primary", "diffuse", "shadow", "uniform"};
+  std::vector<std::string> backends{"embree", "bvh2"};
+  std::vector<int> threads{1};
+  int repetitions = 5;
+  int build_repetitions = 3;
+  std::uint64_t seed = 1;
+  double min_time = 0.05;  // seconds per repetition (Google Benchmark's min time)
+  double warmup = 0.05;    // seconds of untimed warm-up per case
+};
+
+struct Suite {
+  std::string path;
+  SuiteSettings settings;
+  std::vector<SuiteScene> scenes;
+
+  // The scene called `name`, or nullptr.
+  const SuiteScene* find(const std::string& name) const;
+};
+
+// Throws InputError naming the file and key on syntax errors, unknown keys,
+// wrong types or duplicate scene names.
+Suite load_suite(const std::string& path);
+
+}  // namespace raybench

@@ -1,0 +1,348 @@
+#include "suite_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+
+#include <benchmark/benchmark.h>
+#include <fmt/format.h>
+
+#include "agreement.h"
+#include "backend.h"
+#include "error.h"
+#include "metadata.h"
+#include "npy.h"
+#include "rayset.h"
+#include "scene.h"
+#include "trace.h"
+
+namespace raybench {
+namespace {
+
+void progress(const std::string& line) { std::cerr << "raybench: " << line << std::endl; }
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+struct LoadedScene {
+  const SuiteScene* entry = nullptr;  // null for a scene given by path
+  Scene scene;
+};
+
+struct RaySet {
+  RaySetKind kind;
+  std::vector<Ray> rays;
+};
+
+// Rays are stored under a name that carries everything they depend on, so a
+// later run (or a later commit) traces exactly the same rays.
+std::vector<Ray> obtain_rays(const RayGenerator& generator, const Scene& scene, const RaySetSpec& spec,
+                             const std::string& rays_dir) {
+  const std::string path = fmt::format("{}/{}.{}.n{}.{:016x}.npy", rays_dir, scene.name, to_string(spec.kind),
+                                       spec.count, generator.key(spec));
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec)) {
+    try {
+      std::vector<Ray> rays = read_ray_file(path);
+      if (rays.size() == spec.count) {
+        progress(fmt::format("  {} rays: reusing {}", to_string(spec.kind), path));
+        return rays;
+      }
+    } catch (const InputError& e) {
+      progress(fmt::format("  warning: stored ray set unusable, regenerating ({})", e.what()));
+    }
+  }
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<Ray> rays = generator.generate(spec);
+  write_ray_file(path, rays);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  progress(fmt::format("  {} rays: generated {} in {:.0f} ms -> {}", to_string(spec.kind), rays.size(), ms, path));
+  return rays;
+}
+
+// Collects every repetition of every case; prints progress as cases finish.
+class CollectingReporter : public benchmark::BenchmarkReporter {
+ public:
+  explicit CollectingReporter(std::size_t total) : total_(total) {}
+  bool ReportContext(const Context&) override { return true; }
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& run : runs) {
+      if (run.run_type != Run::RT_Iteration) continue;
+      const std::string& name = run.run_name.function_name;
+      if (run.error_occurred) {
+        errors_[name] = run.error_message;
+        continue;
+      }
+      samples_[name].push_back(run.counters.at("rays").value / 1e6);
+    }
+    if (!runs.empty()) {
+      const std::string& name = runs.front().run_name.function_name;
+      const auto& s = samples_[name];
+      progress(fmt::format("  [{}/{}] {}: {:.2f} Mrays/s (median of {})", ++done_, total_, name, median(s), s.size()));
+    }
+  }
+  void Finalize() override {}
+  const std::vector<double>& samples(const std::string& name) { return samples_[name]; }
+  const std::map<std::string, std::string>& errors() const { return errors_; }
+
+ private:
+  std::size_t total_, done_ = 0;
+  std::map<std::string, std::vector<double>> samples_;
+  std::map<std::string, std::string> errors_;
+};
+
+void initialize_google_benchmark(bool interleave) {
+  static bool initialized = false;
+  if (initialized) return;
+  initialized = true;
+  std::string arg0 = "raybench";
+  std::string interleaving = fmt::format("--benchmark_enable_random_interleaving={}", interleave ? "true" : "false");
+  char* argv[] = {arg0.data(), interleaving.data(), nullptr};
+  int argc = 2;
+  benchmark::Initialize(&argc, argv);
+}
+
+LoadedScene load(const RunOptions& options, const std::string& name_or_path) {
+  LoadedScene loaded;
+  loaded.entry = options.suite.find(name_or_path);
+  const std::string spec = loaded.entry ? loaded.entry->path : name_or_path;
+  loaded.scene = load_scene(spec);
+  if (loaded.entry) loaded.scene.name = loaded.entry->name;
+  return loaded;
+}
+
+}  // namespace
+
+std::vector<ResultRow> run_suite(const RunOptions& options) {
+  const SuiteSettings& settings = options.settings;
+  // Validate everything cheap before spending minutes.
+  std::vector<RaySetKind> kinds;
+  for (const std::string& k : settings.raysets) kinds.push_back(parse_rayset_kind(k));
+  for (const std::string& b : settings.backends) make_backend(b);
+  if (settings.rays == 0) throw InputError("", "--rays must be at least 1");
+  if (settings.repetitions < 1) throw InputError("", "--reps must be at least 1");
+  std::vector<std::string> names = options.scenes;
+  if (names.empty()) {
+    for (const SuiteScene& s : options.suite.scenes) {
+      if (s.available()) names.push_back(s.name);
+      else progress(fmt::format("skipping scene '{}': {} not found{}", s.name, s.path, s.optional ? "" : " (not optional!)"));
+    }
+    if (names.empty()) throw InputError(options.suite.path, "no scene of the suite is available");
+  }
+
+  std::vector<LoadedScene> scenes;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    progress(fmt::format("[{}/{}] loading {}", i + 1, names.size(), names[i]));
+    scenes.push_back(load(options, names[i]));
+    const Scene& s = scenes.back().scene;
+    progress(fmt::format("  {} triangles{}", s.triangles.size(),
+                         s.skipped_points + s.skipped_lines
+                             ? fmt::format(" ({} points and {} lines skipped)", s.skipped_points, s.skipped_lines)
+                             : ""));
+  }
+
+  initialize_google_benchmark(options.interleave);
+  std::vector<ResultRow> rows;
+  for (std::size_t si = 0; si < scenes.size(); ++si) {
+    const Scene& scene = scenes[si].scene;
+    const SuiteScene* entry = scenes[si].entry;
+    progress(fmt::format("[{}/{}] {}: ray sets", si + 1, scenes.size(), scene.name));
+    std::vector<RaySet> raysets;
+    {
+      const RayGenerator generator(scene);
+      for (RaySetKind kind : kinds) {
+        RaySetSpec spec{kind, settings.rays, settings.seed, entry ? entry->camera : std::nullopt,
+                        entry ? entry->light : std::nullopt};
+        raysets.push_back({kind, obtain_rays(generator, scene, spec, options.rays_dir)});
+      }
+    }
+
+    struct Case {
+      std::string name;
+      ResultRow row;
+      const Backend* backend;
+      const TraceExecutor* executor;
+      const RaySet* rayset;
+    };
+    std::vector<std::unique_ptr<TraceExecutor>> executors;
+    std::vector<std::unique_ptr<Backend>> backends;
+    std::vector<Case> cases;
+    for (int threads : settings.threads) {
+      executors.push_back(std::make_unique<TraceExecutor>(threads));
+      const TraceExecutor& executor = *executors.back();
+      // The reference's answers, per ray set, for agreement.
+      std::unique_ptr<Backend> reference = make_backend(kReferenceBackend, {threads});
+      executor.run([&] { reference->build(scene); });
+      std::vector<std::vector<Hit>> ref_hits(raysets.size());
+      std::vector<std::vector<std::uint8_t>> ref_occ(raysets.size());
+      for (std::size_t r = 0; r < raysets.size(); ++r) {
+        if (query_of(raysets[r].kind) == Query::kIntersect) {
+          ref_hits[r].resize(raysets[r].rays.size());
+          executor.intersect(*reference, raysets[r].rays, ref_hits[r]);
+        } else {
+          ref_occ[r].resize(raysets[r].rays.size());
+          executor.occluded(*reference, raysets[r].rays, ref_occ[r]);
+        }
+      }
+      reference.reset();
+
+      for (const std::string& backend_name : settings.backends) {
+        std::unique_ptr<Backend> backend = make_backend(backend_name, {threads});
+        std::vector<double> build_ms;
+        for (int b = 0; b < std::max(1, settings.build_repetitions); ++b) {
+          const auto start = std::chrono::steady_clock::now();
+          executor.run([&] { backend->build(scene); });
+          build_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        }
+        progress(fmt::format("  built {} ({} threads) in {:.1f} ms, {:.1f} MiB", backend_name, threads, median(build_ms),
+                             backend->memory_bytes() / 1048576.0));
+        for (std::size_t r = 0; r < raysets.size(); ++r) {
+          const RaySet& rs = raysets[r];
+          ResultRow row;
+          row.scene = scene.name;
+          row.triangles = scene.triangles.size();
+          row.rayset = to_string(rs.kind);
+          row.query = to_string(query_of(rs.kind));
+          row.rays = rs.rays.size();
+          row.backend = backend_name;
+          row.threads = threads;
+          row.build_ms = median(build_ms);
+          row.build_ms_min = *std::min_element(build_ms.begin(), build_ms.end());
+          row.build_ms_max = *std::max_element(build_ms.begin(), build_ms.end());
+          row.memory_bytes = backend->memory_bytes();
+          Agreement a;
+          if (query_of(rs.kind) == Query::kIntersect) {
+            std::vector<Hit> hits(rs.rays.size());
+            executor.intersect(*backend, rs.rays, hits);
+            a = compare_hits(hits, ref_hits[r]);
+          } else {
+            std::vector<std::uint8_t> occ(rs.rays.size());
+            executor.occluded(*backend, rs.rays, occ);
+            a = compare_occlusion(occ, ref_occ[r]);
+          }
+          row.hit_rate = a.hit_rate();
+          row.agree_hit = a.agree_hit();
+          row.agree_prim = a.has_prims ? a.agree_prim() : std::nan("");
+          row.prim_ties = a.prim_ties;
+          row.t_relerr_max = a.has_prims ? a.t_relerr_max : std::nan("");
+          row.t_relerr_p999 = a.has_prims ? a.t_relerr_p999 : std::nan("");
+          row.disagreements = a.disagreements();
+          const std::string name =
+              fmt::format("trace/{}/{}/{}/threads:{}", scene.name, row.rayset, backend_name, threads);
+          cases.push_back({name, row, backend.get(), &executor, &rs});
+        }
+        backends.push_back(std::move(backend));
+      }
+    }
+
+    // Time every case of this scene in one Google Benchmark run, repetitions
+    // interleaved so that a noisy neighbour hits all backends alike.
+    benchmark::ClearRegisteredBenchmarks();
+    for (const Case& c : cases) {
+      const Case* cp = &c;
+      benchmark::RegisterBenchmark(c.name.c_str(),
+                                   [cp](benchmark::State& state) {
+                                     const std::vector<Ray>& rays = cp->rayset->rays;
+                                     std::vector<Hit> hits;
+                                     std::vector<std::uint8_t> occ;
+                                     const bool intersect = query_of(cp->rayset->kind) == Query::kIntersect;
+                                     if (intersect) hits.resize(rays.size());
+                                     else occ.resize(rays.size());
+                                     for (auto _ : state) {
+                                       if (intersect) cp->executor->intersect(*cp->backend, rays, hits);
+                                       else cp->executor->occluded(*cp->backend, rays, occ);
+                                       benchmark::DoNotOptimize(hits.data());
+                                       benchmark::DoNotOptimize(occ.data());
+                                       benchmark::ClobberMemory();
+                                     }
+                                     state.counters["rays"] = benchmark::Counter(static_cast<double>(rays.size()),
+                                                                                 benchmark::Counter::kIsIterationInvariantRate);
+                                   })
+          ->Repetitions(settings.repetitions)
+          ->MinTime(settings.min_time)
+          ->MinWarmUpTime(settings.warmup)
+          ->UseRealTime()
+          ->Unit(benchmark::kMillisecond);
+    }
+    progress(fmt::format("[{}/{}] {}: timing {} cases x {} repetitions", si + 1, scenes.size(), scene.name, cases.size(),
+                         settings.repetitions));
+    CollectingReporter reporter(cases.size());
+    benchmark::RunSpecifiedBenchmarks(&reporter);
+    benchmark::ClearRegisteredBenchmarks();
+    for (Case& c : cases) {
+      if (auto e = reporter.errors().find(c.name); e != reporter.errors().end())
+        throw std::runtime_error(c.name + ": benchmark failed: " + e->second);
+      const std::vector<double>& s = reporter.samples(c.name);
+      if (s.empty()) throw std::runtime_error(c.name + ": benchmark produced no measurement");
+      c.row.mrays_s_samples = s;
+      c.row.reps = static_cast<int>(s.size());
+      c.row.mrays_s = median(s);
+      c.row.mrays_s_min = *std::min_element(s.begin(), s.end());
+      c.row.mrays_s_max = *std::max_element(s.begin(), s.end());
+      rows.push_back(c.row);
+    }
+  }
+
+  // Ratios to Embree measured in the same run: they survive a change of machine.
+  for (ResultRow& row : rows) {
+    for (const ResultRow& ref : rows) {
+      if (ref.backend == kReferenceBackend && ref.scene == row.scene && ref.rayset == row.rayset &&
+          ref.threads == row.threads && ref.mrays_s > 0)
+        row.ratio_to_embree = row.mrays_s / ref.mrays_s;
+    }
+  }
+
+  std::string thread_list, backend_list, rayset_list, scene_list;
+  for (int t : settings.threads) thread_list += (thread_list.empty() ? "" : ",") + std::to_string(t);
+  for (const auto& b : settings.backends) backend_list += (backend_list.empty() ? "" : ",") + b;
+  for (const auto& r : settings.raysets) rayset_list += (rayset_list.empty() ? "" : ",") + r;
+  for (const auto& s : scenes) scene_list += (scene_list.empty() ? "" : ",") + s.scene.name;
+  const Metadata metadata = collect_metadata({
+      {"command", options.command_line},
+      {"suite", options.suite.path},
+      {"scenes", scene_list},
+      {"raysets", rayset_list},
+      {"backends", backend_list},
+      {"threads", thread_list},
+      {"rays", std::to_string(settings.rays)},
+      {"seed", std::to_string(settings.seed)},
+      {"repetitions", std::to_string(settings.repetitions)},
+      {"min_time_s", fmt::format("{}", settings.min_time)},
+      {"warmup_s", fmt::format("{}", settings.warmup)},
+      {"interleaved", options.interleave ? "true" : "false"},
+      {"reference_backend", kReferenceBackend},
+  });
+  write_results_csv(options.out_csv, rows);
+  write_metadata(metadata_path_for(options.out_csv), metadata);
+  return rows;
+}
+
+std::string format_results_table(const std::vector<ResultRow>& rows) {
+  std::string out;
+  std::string scene;
+  const auto percent = [](double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.3f}%", 100.0 * v); };
+  for (const ResultRow& r : rows) {
+    if (r.scene != scene) {
+      scene = r.scene;
+      out += fmt::format("\n{} ({} triangles)\n", r.scene, r.triangles);
+      out += fmt::format("  {:<8} {:<18} {:>3} {:>9} {:>19} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9}\n", "rayset", "backend",
+                         "thr", "Mrays/s", "[min - max]", "x embree", "hit", "agree", "same tri", "build ms", "MiB");
+    }
+    out += fmt::format("  {:<8} {:<18} {:>3} {:>9.2f} {:>19} {:>8} {:>8} {:>9} {:>9} {:>9.1f} {:>9.1f}\n", r.rayset,
+                       r.backend, r.threads, r.mrays_s, fmt::format("[{:.2f} - {:.2f}]", r.mrays_s_min, r.mrays_s_max),
+                       r.ratio_to_embree > 0 ? fmt::format("{:.2f}", r.ratio_to_embree) : "-",
+                       fmt::format("{:.1f}%", 100.0 * r.hit_rate), percent(r.agree_hit), percent(r.agree_prim),
+                       r.build_ms, r.memory_bytes / 1048576.0);
+  }
+  return out;
+}
+
+}  // namespace raybench

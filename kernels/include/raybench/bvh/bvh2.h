@@ -1,0 +1,53 @@
+// A binary BVH over triangles: the topology only. What a leaf's triangles
+// look like to the intersector (Prepared data) is kept by the caller, in the
+// order of `prim_ids`, so one tree serves every triangle test.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "raybench/math/bbox.h"
+#include "raybench/prim/triangle.h"
+
+namespace raybench {
+
+// 32 bytes, two to a cache line. An inner node's children are stored next to
+// each other at first_index and first_index + 1; a leaf holds prim_count > 0
+// primitives starting at prim_ids[first_index].
+struct Bvh2Node {
+  BBox bounds;
+  std::uint32_t first_index = 0;
+  std::uint32_t prim_count = 0;
+
+  bool is_leaf() const { return prim_count != 0; }
+};
+static_assert(sizeof(Bvh2Node) == 32);
+
+struct Bvh2 {
+  std::vector<Bvh2Node> nodes;           // nodes[0] is the root
+  std::vector<std::uint32_t> prim_ids;   // leaf order -> index in the input array
+
+  std::size_t memory_bytes() const {
+    return nodes.size() * sizeof(Bvh2Node) + prim_ids.size() * sizeof(std::uint32_t);
+  }
+  // Surface-area-heuristic cost of the tree, relative to the root's area,
+  // with traversal cost 1 and intersection cost 1 per primitive.
+  double sah_cost() const;
+};
+
+struct Bvh2BuildOptions {
+  int bin_count = 16;       // SAH bins per axis (Wald 2007, "On fast construction of SAH-based BVHs")
+  int max_leaf_size = 8;    // a larger range is always split
+  float traversal_cost = 1.0f;  // relative to one ray-triangle test
+  int max_sah_depth = 64;   // deeper ranges are halved, bounding the traversal stack
+  std::size_t parallel_threshold = 4096;  // subtrees at least this large are built as TBB tasks
+};
+
+// Binned-SAH build over the given triangles (top-down, centroid binning on
+// all three axes). Every triangle is placed in exactly one leaf, degenerate
+// ones included; the structure is deterministic for a given input.
+Bvh2 build_bvh2_binned_sah(std::span<const Triangle> triangles, const Bvh2BuildOptions& options = {});
+
+}  // namespace raybench
