@@ -78,14 +78,24 @@ RayGenerator::RayGenerator(const Scene& scene) : scene_(scene), bounds_(scene.bo
 }
 
 Camera RayGenerator::default_camera() const {
-  // Frame the bounding sphere from outside, from above and to the side.
+  // Look at the box's centre from above and to the side, as close as possible
+  // with all eight corners inside the frame (plus a 5 % margin): corner c at
+  // lateral offset x and depth offset z needs distance d >= |x| / tan(half fov) - z.
   Camera c;
   const Eigen::Vector3d center = to_eigen(bounds_.center());
-  const double radius = 0.5 * to_eigen(bounds_.extent()).norm();
-  const double half_fov_v = std::atan(std::tan(c.fov_degrees * std::numbers::pi / 360.0) / c.aspect);
-  const double distance = radius / std::sin(half_fov_v);
-  const Eigen::Vector3d from = Eigen::Vector3d(0.6, 0.45, 1.0).normalized();
-  c.position = to_vec(center + from * distance);
+  const Eigen::Vector3d forward = -Eigen::Vector3d(0.6, 0.45, 1.0).normalized();
+  const Eigen::Vector3d right = forward.cross(to_eigen(c.up)).normalized();
+  const Eigen::Vector3d up = right.cross(forward);
+  const double tan_w = std::tan(c.fov_degrees * std::numbers::pi / 360.0), tan_h = tan_w / c.aspect;
+  double distance = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d p((corner & 1 ? bounds_.upper : bounds_.lower).x, (corner & 2 ? bounds_.upper : bounds_.lower).y,
+                            (corner & 4 ? bounds_.upper : bounds_.lower).z);
+    const Eigen::Vector3d q = p - center;
+    const double z = q.dot(forward);
+    distance = std::max({distance, std::fabs(q.dot(right)) * 1.05 / tan_w - z, std::fabs(q.dot(up)) * 1.05 / tan_h - z});
+  }
+  c.position = to_vec(center - forward * distance);
   c.look_at = to_vec(center);
   return c;
 }

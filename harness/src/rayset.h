@@ -43,7 +43,7 @@ struct RaySetSpec {
 
 // Bumped whenever generation changes, so stored ray sets are never reused
 // across generator versions.
-inline constexpr int kRayGeneratorVersion = 1;
+inline constexpr int kRayGeneratorVersion = 2;
 
 // Makes ray sets for one scene. Diffuse and shadow rays start at primary
 // hits, found with our BVH2 (built once here).

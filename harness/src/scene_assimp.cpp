@@ -29,6 +29,7 @@ void collect(const aiScene& ai, const aiNode& node, const Eigen::Matrix4d& paren
   const Eigen::Matrix4d world = parent * to_eigen(node.mTransformation);
   for (unsigned m = 0; m < node.mNumMeshes; ++m) {
     const aiMesh& mesh = *ai.mMeshes[node.mMeshes[m]];
+    if (mesh.mNumFaces == 0) out.skipped_points += mesh.mNumVertices;  // a point cloud stores bare vertices
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
       const aiFace& face = mesh.mFaces[f];
       if (face.mNumIndices == 1) { ++out.skipped_points; continue; }
@@ -42,6 +43,19 @@ void collect(const aiScene& ai, const aiNode& node, const Eigen::Matrix4d& paren
   for (unsigned c = 0; c < node.mNumChildren; ++c) collect(ai, *node.mChildren[c], world, out);
 }
 
+// assimp 5.2's PLY reader loops forever on a header without "end_header" (a
+// file cut short inside its header): refuse such a file before assimp sees it.
+void check_ply_header(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(4, '\0');
+  if (!in.read(head.data(), 4) || (head != "ply\n" && head != "ply\r")) return;
+  std::string line;
+  for (int lines = 0; lines < 100000 && std::getline(in, line); ++lines) {
+    if (line.rfind("end_header", 0) == 0) return;
+  }
+  throw InputError(path, "malformed PLY: the header never ends (no end_header line)");
+}
+
 Scene load_mesh_file(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -49,6 +63,7 @@ Scene load_mesh_file(const std::string& path) {
   if (fs::is_directory(path, ec)) throw InputError(path, "is a directory, not a mesh file");
   if (!std::ifstream(path).good()) throw InputError(path, "cannot be opened for reading");
 
+  check_ply_header(path);
   Assimp::Importer importer;
   // Triangulate only. No FindDegenerates/SortByPType: they turn the 52,670
   // coincident-vertex triangles of conference.ply into lines, and every
@@ -69,7 +84,7 @@ Scene load_mesh_file(const std::string& path) {
   collect(*ai, *ai->mRootNode, Eigen::Matrix4d::Identity(), scene);
   if (scene.triangles.empty()) {
     throw InputError(path, "contains no triangles (" + std::to_string(scene.skipped_points) + " points, " +
-                               std::to_string(scene.skipped_lines) + " lines): nothing to trace");
+                               std::to_string(scene.skipped_lines) + " lines): nothing to trace");  // e.g. a point cloud
   }
   return scene;
 }

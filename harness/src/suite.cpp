@@ -127,7 +127,13 @@ Suite load_suite(const std::string& path) {
                                   "min_time", "warmup"});
     s.rays = r.get<std::size_t>(*t, "defaults.", "rays", s.rays);
     s.raysets = r.strings(*t, "defaults.", "raysets", s.raysets);
-    for (const std::string& k : s.raysets) parse_rayset_kind(k);
+    for (const std::string& k : s.raysets) {
+      try {
+        parse_rayset_kind(k);
+      } catch (const InputError& e) {
+        r.fail("defaults.raysets", e.what());
+      }
+    }
     s.backends = r.strings(*t, "defaults.", "backends", s.backends);
     if (const toml::node* th = t->get("threads")) {
       const toml::array* a = th->as_array();

@@ -83,7 +83,8 @@ class CollectingReporter : public benchmark::BenchmarkReporter {
       }
       samples_[name].push_back(run.counters.at("rays").value / 1e6);
     }
-    if (!runs.empty()) {
+    // Google Benchmark reports a case twice: its repetitions, then aggregates.
+    if (!runs.empty() && runs.front().run_type == Run::RT_Iteration) {
       const std::string& name = runs.front().run_name.function_name;
       const auto& s = samples_[name];
       progress(fmt::format("  [{}/{}] {}: {:.2f} Mrays/s (median of {})", ++done_, total_, name, median(s), s.size()));

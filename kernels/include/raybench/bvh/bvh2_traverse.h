@@ -12,30 +12,39 @@
 
 namespace raybench {
 
-// Reciprocal direction and the ray interval, computed once per ray.
+// Reciprocal direction, its signs and the ray interval, computed once per ray.
 struct RayBoxPrecomputed {
   Vec3f org, inv_dir;
+  bool negative[3];
   float tnear, tfar;
 
   explicit RayBoxPrecomputed(const Ray& r)
-      : org(r.org), inv_dir{1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z}, tnear(r.tnear), tfar(r.tfar) {}
+      : org(r.org),
+        inv_dir{1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z},
+        negative{std::signbit(inv_dir.x), std::signbit(inv_dir.y), std::signbit(inv_dir.z)},
+        tnear(r.tnear),
+        tfar(r.tfar) {}
 };
 
-// Slab test of seed 000 in its branchless form (Kay & Kajiya 1986; Williams et
-// al. 2005 use the same reciprocal). A zero direction component gives an
-// infinite reciprocal; if the origin then lies on that slab's plane the product
-// is NaN, and the comparisons below are ordered so a NaN slab is ignored (the
-// ray lies in the plane of a closed box face, so that slab does not bound it).
+// Slab test of seed 000 in branchless form (Kay & Kajiya 1986), choosing each
+// axis's entry and exit plane by the direction's sign (Williams et al. 2005,
+// as in pbrt-v4's Bounds3::IntersectP) rather than by comparing the two
+// distances. That choice makes the NaN case safe: a zero direction component
+// has an infinite reciprocal, and an origin exactly on that slab's plane gives
+// 0 * inf = NaN; the comparisons below keep the previous bound when a
+// distance is NaN, so the slab does not constrain a ray lying in the plane of
+// a closed box face. An empty box (lower = +inf, upper = -inf) is missed.
+// Not conservative: rounding may miss a box the exact ray grazes.
 // Returns the entry distance, or +inf when the box is missed within [tnear, tmax].
 inline float enter_box(const RayBoxPrecomputed& r, const BBox& b, float tmax) {
   float entry = r.tnear, exit = tmax;
   for (int axis = 0; axis < 3; ++axis) {
-    const float t0 = (b.lower[axis] - r.org[axis]) * r.inv_dir[axis];
-    const float t1 = (b.upper[axis] - r.org[axis]) * r.inv_dir[axis];
-    const float near = t0 < t1 ? t0 : t1;
-    const float far = t0 < t1 ? t1 : t0;
-    entry = near > entry ? near : entry;
-    exit = far < exit ? far : exit;
+    const float near_plane = r.negative[axis] ? b.upper[axis] : b.lower[axis];
+    const float far_plane = r.negative[axis] ? b.lower[axis] : b.upper[axis];
+    const float t_near = (near_plane - r.org[axis]) * r.inv_dir[axis];
+    const float t_far = (far_plane - r.org[axis]) * r.inv_dir[axis];
+    entry = t_near > entry ? t_near : entry;
+    exit = t_far < exit ? t_far : exit;
   }
   return entry <= exit ? entry : std::numeric_limits<float>::infinity();
 }
@@ -54,6 +63,7 @@ inline void traverse_bvh2(const Bvh2& bvh, const Ray& ray, LeafFn&& leaf) {
   std::uint32_t stack[kBvh2StackSize];
   int top = 0;
   const Bvh2Node* nodes = bvh.nodes.data();
+  if (bvh.prim_ids.empty()) return;  // the root of an empty tree is an empty inner node
   if (enter_box(r, nodes[0].bounds, tmax) == std::numeric_limits<float>::infinity()) return;
   std::uint32_t current = 0;
   for (;;) {

@@ -1,0 +1,58 @@
+// Specification of per-ray agreement (harness/src/agreement.h).
+#include "agreement.h"
+
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace raybench {
+namespace {
+
+const Hit kMiss{};
+
+TEST(Agreement, CountsHitMissPrimAndTiesPerRay) {
+  const std::vector<Hit> reference{{1.0f, 7, 0, 0}, {2.0f, 3, 0, 0}, kMiss, {4.0f, 1, 0, 0}, {5.0f, 9, 0, 0}};
+  const std::vector<Hit> tested{{1.0f, 7, 0, 0},   // same
+                                {2.0f, 4, 0, 0},   // another triangle at the same t: a tie
+                                {3.0f, 2, 0, 0},   // hit where the reference misses
+                                kMiss,             // miss where the reference hits
+                                {5.5f, 8, 0, 0}};  // another triangle, farther
+  const Agreement a = compare_hits(tested, reference);
+  EXPECT_EQ(a.rays, 5u);
+  EXPECT_DOUBLE_EQ(a.hit_rate(), 4.0 / 5);
+  EXPECT_DOUBLE_EQ(a.agree_hit(), 3.0 / 5);
+  EXPECT_EQ(a.both_hit, 3u);
+  EXPECT_DOUBLE_EQ(a.agree_prim(), 1.0 / 3);
+  EXPECT_EQ(a.prim_ties, 1u);
+  EXPECT_EQ(a.disagreements(), 2u + 2u);
+  EXPECT_DOUBLE_EQ(a.t_relerr_max, 0.1);  // |5.5 - 5| / 5
+  EXPECT_DOUBLE_EQ(a.t_relerr_p999, 0.1);
+}
+
+TEST(Agreement, PercentileIgnoresTheRareOutlier) {
+  std::vector<Hit> reference(2000, Hit{1.0f, 0, 0, 0}), tested = reference;
+  tested[5].t = 2.0f;  // one ray in 2000: above the 99.9th percentile
+  const Agreement a = compare_hits(tested, reference);
+  EXPECT_DOUBLE_EQ(a.t_relerr_max, 1.0);
+  EXPECT_DOUBLE_EQ(a.t_relerr_p999, 0.0);
+}
+
+TEST(Agreement, IdenticalAnswersAgreeCompletely) {
+  const std::vector<Hit> hits{{1.0f, 1, 0.5f, 0.25f}, kMiss};
+  const Agreement a = compare_hits(hits, hits);
+  EXPECT_DOUBLE_EQ(a.agree_hit(), 1.0);
+  EXPECT_DOUBLE_EQ(a.agree_prim(), 1.0);
+  EXPECT_EQ(a.disagreements(), 0u);
+}
+
+TEST(Agreement, OcclusionComparesFlagsOnly) {
+  const std::vector<std::uint8_t> reference{1, 0, 1, 0}, tested{1, 1, 0, 0};
+  const Agreement a = compare_occlusion(tested, reference);
+  EXPECT_FALSE(a.has_prims);
+  EXPECT_DOUBLE_EQ(a.hit_rate(), 0.5);
+  EXPECT_DOUBLE_EQ(a.agree_hit(), 0.5);
+  EXPECT_EQ(a.disagreements(), 2u);
+}
+
+}  // namespace
+}  // namespace raybench

@@ -1,0 +1,116 @@
+// Specification of the .npy reader and writer (harness/src/npy.h).
+#include "npy.h"
+
+#include <cstring>
+#include <fstream>
+#include <limits>
+
+#include "error.h"
+#include "test_util.h"
+
+namespace raybench {
+namespace {
+
+using testing::TempDir;
+
+std::string npy_bytes(const std::string& dict, std::size_t body_bytes, int major = 1) {
+  std::string header = dict;
+  const std::size_t prefix = major == 1 ? 10 : 12;
+  header.append((64 - (prefix + header.size() + 1) % 64) % 64, ' ');
+  header += '\n';
+  std::string out = "\x93NUMPY";
+  out += static_cast<char>(major);
+  out += '\0';
+  const std::size_t n = header.size();
+  out += static_cast<char>(n & 0xff);
+  out += static_cast<char>((n >> 8) & 0xff);
+  if (major != 1) out += std::string(2, '\0');
+  return out + header + std::string(body_bytes, '\0');
+}
+
+std::string error_of(const std::string& path) {
+  try {
+    read_ray_file(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Npy, RayFileRoundTripsBitExactly) {
+  TempDir dir;
+  std::vector<Ray> rays(3);
+  rays[0] = Ray{{1, 2, 3}, 0.5f, {0, 0, -1}, 100.0f};
+  rays[1] = Ray{{-0.0f, 1e-30f, 1e30f}, 0.0f, {1, 0, 0}, std::numeric_limits<float>::infinity()};
+  rays[2].org.x = std::numeric_limits<float>::quiet_NaN();
+  write_ray_file(dir.file("r.npy"), rays);
+  const std::vector<Ray> back = read_ray_file(dir.file("r.npy"));
+  ASSERT_EQ(back.size(), rays.size());
+  EXPECT_EQ(std::memcmp(back.data(), rays.data(), rays.size() * sizeof(Ray)), 0);
+}
+
+TEST(Npy, HeaderIsAlignedTo64BytesAsNumpyWritesIt) {
+  TempDir dir;
+  write_ray_file(dir.file("r.npy"), std::vector<Ray>(2));
+  EXPECT_EQ(std::filesystem::file_size(dir.file("r.npy")), 128u + 2 * 32);
+}
+
+TEST(Npy, EmptyRayFileRoundTrips) {
+  TempDir dir;
+  write_ray_file(dir.file("r.npy"), {});
+  EXPECT_TRUE(read_ray_file(dir.file("r.npy")).empty());
+}
+
+TEST(Npy, ReadsVersion2Headers) {
+  TempDir dir;
+  const auto path = dir.write("v2.npy", npy_bytes("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 8), }", 64, 2));
+  EXPECT_EQ(read_ray_file(path).size(), 2u);
+}
+
+TEST(Npy, RejectsWhatIsNotARayFileNamingTheFileAndProblem) {
+  TempDir dir;
+  const struct {
+    const char* name;
+    std::string bytes;
+    const char* problem;
+  } cases[] = {
+      {"magic.npy", "not numpy at all", "bad magic"},
+      {"f8.npy", npy_bytes("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 8), }", 128), "dtype is '<f8'"},
+      {"big_endian.npy", npy_bytes("{'descr': '>f4', 'fortran_order': False, 'shape': (2, 8), }", 64), "dtype is '>f4'"},
+      {"shape7.npy", npy_bytes("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 7), }", 56), "shape is (2, 7)"},
+      {"shape1d.npy", npy_bytes("{'descr': '<f4', 'fortran_order': False, 'shape': (16,), }", 64), "shape is (16,)"},
+      {"fortran.npy", npy_bytes("{'descr': '<f4', 'fortran_order': True, 'shape': (2, 8), }", 64), "Fortran order"},
+      {"truncated.npy", npy_bytes("{'descr': '<f4', 'fortran_order': False, 'shape': (4, 8), }", 100), "truncated"},
+      {"trailing.npy", npy_bytes("{'descr': '<f4', 'fortran_order': False, 'shape': (1, 8), }", 40), "unexpected bytes"},
+      {"header.npy", std::string("\x93NUMPY\x01\x00\xff\x00", 10) + "{'descr'", "truncated .npy header"},
+      {"nodescr.npy", npy_bytes("{'fortran_order': False, 'shape': (1, 8), }", 32), "no 'descr'"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = dir.write(c.name, c.bytes);
+    const std::string error = error_of(path);
+    EXPECT_NE(error.find(path), std::string::npos) << c.name << ": " << error;
+    EXPECT_NE(error.find(c.problem), std::string::npos) << c.name << ": " << error;
+  }
+  EXPECT_NE(error_of(dir.file("absent.npy")).find("no such file"), std::string::npos);
+}
+
+TEST(Npy, Float64MatricesRoundTrip) {
+  TempDir dir;
+  const std::vector<double> data{1, 2, 3, 4, 5, 6, std::numeric_limits<double>::infinity(), -1};
+  write_npy_f64(dir.file("h.npy"), data, 2, 4);
+  std::size_t rows = 0, columns = 0;
+  EXPECT_EQ(read_npy_f64(dir.file("h.npy"), rows, columns), data);
+  EXPECT_EQ(rows, 2u);
+  EXPECT_EQ(columns, 4u);
+}
+
+TEST(Npy, AFailedWriteLeavesNoFileBehind) {
+  TempDir dir;
+  std::filesystem::create_directories(dir.file("occupied.npy"));  // a directory where the file should go
+  EXPECT_THROW(write_ray_file(dir.file("occupied.npy"), std::vector<Ray>(1)), InputError);
+  for (const auto& e : std::filesystem::directory_iterator(dir.file("")))
+    EXPECT_EQ(e.path().filename(), "occupied.npy") << "left behind: " << e.path();
+}
+
+}  // namespace
+}  // namespace raybench

@@ -1,0 +1,78 @@
+// Specification of the results CSV (harness/src/results_csv.h): the schema
+// the README documents and later tools (compare, gate) read.
+#include "results_csv.h"
+
+#include <cmath>
+#include <fstream>
+
+#include "error.h"
+#include "metadata.h"
+#include "test_util.h"
+
+namespace raybench {
+namespace {
+
+using testing::TempDir;
+
+TEST(ResultsCsv, HasTheDocumentedColumnsInOrder) {
+  const std::vector<std::string> required = {
+      "scene", "triangles", "rayset", "rays", "backend", "threads", "build_ms", "memory_bytes", "mrays_s",
+      "mrays_s_min", "mrays_s_max", "reps", "hit_rate", "agree_hit", "agree_prim", "t_relerr_max", "t_relerr_p999",
+      "disagreements"};
+  const auto& columns = result_columns();
+  std::size_t last = 0;
+  for (const std::string& c : required) {
+    const auto it = std::find(columns.begin(), columns.end(), c);
+    ASSERT_NE(it, columns.end()) << "missing column " << c;
+    const auto index = static_cast<std::size_t>(it - columns.begin());
+    EXPECT_GE(index, last) << c << " out of the documented order";
+    last = index;
+  }
+}
+
+TEST(ResultsCsv, RowsRoundTripAndNotApplicableIsEmpty) {
+  TempDir dir;
+  ResultRow row;
+  row.scene = "bunny, scanned";  // a comma forces quoting
+  row.triangles = 69451;
+  row.rayset = "shadow";
+  row.query = "occluded";
+  row.rays = 1000;
+  row.backend = "embree:high";
+  row.threads = 2;
+  row.mrays_s = 12.5;
+  row.mrays_s_samples = {12.0, 12.5, 13.0};
+  row.reps = 3;
+  row.agree_prim = std::nan("");
+  row.t_relerr_max = std::nan("");
+  row.disagreements = 4;
+  write_results_csv(dir.file("r.csv"), {row});
+  const auto rows = read_results_csv(dir.file("r.csv"));
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].at("scene"), "bunny, scanned");
+  EXPECT_EQ(rows[0].at("backend"), "embree:high");
+  EXPECT_EQ(rows[0].at("threads"), "2");
+  EXPECT_EQ(rows[0].at("mrays_s"), "12.5");
+  EXPECT_EQ(rows[0].at("mrays_s_samples"), "12;12.5;13");
+  EXPECT_EQ(rows[0].at("agree_prim"), "");
+  EXPECT_EQ(rows[0].at("t_relerr_max"), "");
+  EXPECT_EQ(rows[0].at("disagreements"), "4");
+}
+
+TEST(ResultsCsv, AFileWithoutTheSchemaIsRejected) {
+  TempDir dir;
+  const auto path = dir.write("other.csv", "name,time\nx,1\n");
+  EXPECT_THROW(read_results_csv(path), InputError);
+}
+
+TEST(Metadata, RecordsWhatAResultDependsOn) {
+  const Metadata m = collect_metadata({{"threads", "2"}});
+  std::map<std::string, std::string> keys(m.begin(), m.end());
+  for (const char* k : {"cpu", "compiler", "flags", "embree", "git_commit", "date", "threads"})
+    EXPECT_FALSE(keys[k].empty()) << k;
+  EXPECT_EQ(keys["embree"].rfind("3.", 0), 0u);
+  EXPECT_EQ(metadata_path_for("results/latest.csv"), "results/latest.meta.toml");
+}
+
+}  // namespace
+}  // namespace raybench

@@ -1,0 +1,79 @@
+// Specification of suite manifests (harness/src/suite.h).
+#include "suite.h"
+
+#include "build_info.h"
+#include "error.h"
+#include "test_util.h"
+
+namespace raybench {
+namespace {
+
+using testing::TempDir;
+
+std::string error_of(const std::string& path) {
+  try {
+    load_suite(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Suite, TheDefaultSuiteParsesAndIncludesTheMillionTriangleProceduralScene) {
+  const Suite s = load_suite(std::string(RAYBENCH_SOURCE_DIR) + "/meshes/default.toml");
+  ASSERT_NE(s.find("terrain_spheres"), nullptr);
+  EXPECT_TRUE(s.find("terrain_spheres")->available());
+  for (const char* interior : {"sponza", "conference", "sibenik", "sponza_dabrovic"}) {
+    ASSERT_NE(s.find(interior), nullptr) << interior;
+    EXPECT_TRUE(s.find(interior)->camera.has_value()) << interior << " needs its camera inside";
+  }
+  EXPECT_EQ(s.settings.backends, (std::vector<std::string>{"embree", "bvh2"}));
+}
+
+TEST(Suite, PathsAreResolvedAgainstTheManifestsFolder) {
+  TempDir dir;
+  const auto path = dir.write("s.toml", "[[scene]]\nname = \"m\"\npath = \"sub/m.obj\"\n");
+  EXPECT_EQ(load_suite(path).scenes[0].path, dir.file("sub/m.obj"));
+}
+
+TEST(Suite, CamerasAndLightsAreRead) {
+  TempDir dir;
+  const auto path = dir.write("s.toml",
+                              "[defaults]\nrays = 1000\nthreads = [1, 2]\n"
+                              "[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\n"
+                              "camera = { position = [0, 0, 5], look_at = [0, 0, 0], fov = 40 }\nlight = [1, 2, 3]\n");
+  const Suite s = load_suite(path);
+  EXPECT_EQ(s.settings.rays, 1000u);
+  EXPECT_EQ(s.settings.threads, (std::vector<int>{1, 2}));
+  ASSERT_TRUE(s.scenes[0].camera);
+  EXPECT_EQ(s.scenes[0].camera->position.z, 5.0f);
+  EXPECT_EQ(s.scenes[0].camera->fov_degrees, 40.0f);
+  EXPECT_EQ(s.scenes[0].light->y, 2.0f);
+}
+
+TEST(Suite, MistakesNameTheFileAndTheKey) {
+  TempDir dir;
+  const struct {
+    const char* text;
+    const char* problem;
+  } cases[] = {
+      {"[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\ncolour = 1\n", "scene[0].colour': unknown key"},
+      {"[defaults]\nrays = \"many\"\n[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\n", "defaults.rays"},
+      {"[defaults]\nraysets = [\"specular\"]\n[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\n", "specular"},
+      {"[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\n[[scene]]\nname = \"a\"\npath = \"x.obj\"\n", "duplicate"},
+      {"[[scene]]\nname = \"a\"\npath = \"p\"\ncamera = { position = [0, 0] , look_at = [0,0,0] }\n", "camera.position"},
+      {"[[scene]]\nname = \"a\"\n", "needs a name and a path"},
+      {"[defaults\n", "line 1"},
+      {"[defaults]\n", "no [[scene]]"},
+  };
+  int i = 0;
+  for (const auto& c : cases) {
+    const auto path = dir.write("bad" + std::to_string(i++) + ".toml", c.text);
+    const std::string error = error_of(path);
+    EXPECT_NE(error.find(path), std::string::npos) << error;
+    EXPECT_NE(error.find(c.problem), std::string::npos) << "expected '" << c.problem << "' in: " << error;
+  }
+}
+
+}  // namespace
+}  // namespace raybench

@@ -1,0 +1,44 @@
+# Shared by scripts/bench and scripts/test (sourced, not run): installs what
+# is missing from Debian, configures and builds Release. Works from any
+# working directory; the build lives in <repo>/build unless RAYBENCH_BUILD_DIR
+# says otherwise.
+set -eu
+
+RAYBENCH_ROOT=$(cd "$(dirname "$(readlink -f "$0")")/.." && pwd)
+RAYBENCH_BUILD_DIR=${RAYBENCH_BUILD_DIR:-"$RAYBENCH_ROOT/build"}
+export RAYBENCH_ROOT RAYBENCH_BUILD_DIR
+
+# Every Debian package raybench builds, tests or plots with.
+RAYBENCH_PACKAGES="cmake ninja-build g++ git pkg-config libembree-dev libassimp-dev assimp-utils assimp-testmodels \
+libeigen3-dev libbenchmark-dev libgtest-dev libtbb-dev libcli11-dev libfmt-dev libtomlplusplus-dev \
+python3 python3-numpy python3-matplotlib"
+
+raybench_install_packages() {
+  missing=""
+  for p in $RAYBENCH_PACKAGES; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+  done
+  [ -z "$missing" ] && return 0
+  if [ "$(id -u)" = 0 ]; then
+    echo "raybench setup: installing$missing" >&2
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq >&2
+    # shellcheck disable=SC2086
+    apt-get install -y -qq --no-install-recommends $missing >&2
+  else
+    echo "raybench setup: missing Debian packages. Install them with:" >&2
+    echo "  sudo apt-get install -y$missing" >&2
+    exit 1
+  fi
+}
+
+raybench_build() {
+  jobs=$(nproc 2>/dev/null || echo 2)
+  if [ ! -f "$RAYBENCH_BUILD_DIR/build.ninja" ]; then
+    cmake -S "$RAYBENCH_ROOT" -B "$RAYBENCH_BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release >&2
+  fi
+  cmake --build "$RAYBENCH_BUILD_DIR" -j "$jobs" >&2
+}
+
+raybench_install_packages
+raybench_build
