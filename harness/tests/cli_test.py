@@ -1,0 +1,225 @@
+"""The raybench command line, driven as a user drives it: numpy writes and reads
+the ray and hit files, bad input must give one line on stderr naming the file,
+exit status 2, and no result file.
+
+Run through ctest (harness/tests/CMakeLists.txt sets RAYBENCH and the mesh folders).
+"""
+import csv
+import os
+import subprocess
+import tempfile
+import tomllib
+import unittest
+
+import numpy as np
+
+RAYBENCH = os.environ["RAYBENCH"]
+MODELS = os.environ.get("RAYBENCH_ASSIMP_MODELS", "/usr/share/assimp/models")
+WUSON = os.path.join(MODELS, "PLY", "Wuson.ply")
+POND = os.path.join(MODELS, "PLY", "pond.0.ply")
+SCENE = "proc:terrain_spheres_small"
+
+
+def run(*args):
+    return subprocess.run([RAYBENCH, *args], capture_output=True, text=True, timeout=300)
+
+
+class CliTestCase(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def assertBadInput(self, result, *fragments):
+        """Exit 2 and one error line on stderr, the last, naming each fragment (progress lines may precede it)."""
+        self.assertEqual(result.returncode, 2, result.stderr)
+        lines = result.stderr.strip().splitlines()
+        errors = [line for line in lines if line.startswith("raybench: error: ")]
+        self.assertEqual(len(errors), 1, result.stderr)
+        self.assertEqual(errors[0], lines[-1], result.stderr)
+        for fragment in fragments:
+            self.assertIn(fragment, errors[0])
+
+    def make_rays(self, kind="primary", count=2000, scene=SCENE):
+        out = self.path(f"{kind}.npy")
+        result = run("rays", "--scene", scene, "--kind", kind, "-n", str(count), "-o", out)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        return out
+
+
+class RayFiles(CliTestCase):
+    def test_rays_are_float32_n_by_8_and_readable_by_numpy(self):
+        rays = np.load(self.make_rays("diffuse", 1500))
+        self.assertEqual(rays.dtype, np.float32)
+        self.assertEqual(rays.shape, (1500, 8))
+        np.testing.assert_allclose(np.linalg.norm(rays[:, 4:7], axis=1), 1.0, rtol=1e-5)
+
+    def test_same_arguments_give_identical_rays(self):
+        a = np.load(self.make_rays("uniform", 1000))
+        b = np.load(self.make_rays("uniform", 1000))
+        self.assertTrue(np.array_equal(a, b))
+
+    def test_trace_writes_float64_hits_that_backends_agree_on(self):
+        rays = self.make_rays("primary", 3000)
+        hits = {}
+        for backend in ("embree", "bvh2"):
+            out = self.path(f"hits_{backend}.npy")
+            result = run("trace", "--scene", SCENE, "--rays", rays, "-b", backend, "-o", out)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            hits[backend] = np.load(out)
+            self.assertEqual(hits[backend].dtype, np.float64)
+            self.assertEqual(hits[backend].shape, (3000, 4))
+        e, b = hits["embree"], hits["bvh2"]
+        self.assertTrue(np.isfinite(e[:, 0]).any())
+        self.assertTrue(np.array_equal(np.isinf(e[:, 0]), e[:, 1] == -1))  # miss: t = inf and prim = -1
+        self.assertGreaterEqual((np.isfinite(e[:, 0]) == np.isfinite(b[:, 0])).mean(), 0.9999)
+
+    def test_occlusion_mode_says_so_and_writes_flags(self):
+        rays = self.make_rays("shadow", 1000)
+        out = self.path("occ.npy")
+        result = run("trace", "--scene", SCENE, "--rays", rays, "-b", "bvh2", "--occluded", "-o", out)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertIn("occlusion", result.stdout)
+        flags = np.load(out)
+        self.assertEqual(flags.shape, (1000, 1))
+        self.assertTrue(set(np.unique(flags)) <= {0.0, 1.0})
+
+    def test_user_supplied_rays_with_nan_and_inf_are_traced_as_misses(self):
+        rays = np.zeros((8, 8), dtype=np.float32)
+        rays[:, 1] = 50.0  # above the terrain, looking down
+        rays[:, 5] = -1.0
+        rays[:, 7] = np.inf
+        rays[1, 0] = np.nan
+        rays[2, 4:7] = np.nan
+        rays[3, 2] = np.inf
+        rays[4, 5] = -np.inf
+        rays[5, 3] = np.nan  # tnear
+        rays[6, 7] = np.nan  # tfar
+        path = self.path("nasty.npy")
+        np.save(path, rays)
+        for backend in ("embree", "embree:robust", "bvh2"):
+            out = self.path("h.npy")
+            result = run("trace", "--scene", SCENE, "--rays", path, "-b", backend, "-o", out)
+            self.assertEqual(result.returncode, 0, f"{backend}: {result.stderr}")
+            hits = np.load(out)
+            self.assertTrue(np.isfinite(hits[0, 0]), f"{backend}: the clean ray must hit")
+            self.assertTrue(np.all(hits[1:7, 1] == -1), f"{backend}: {hits}")
+
+
+class BadInput(CliTestCase):
+    def trace(self, rays, scene=SCENE, backend="bvh2"):
+        out = self.path("hits.npy")
+        result = run("trace", "--scene", scene, "--rays", rays, "-b", backend, "-o", out)
+        self.assertFalse(os.path.exists(out), "a failed run must not leave a result file")
+        return result
+
+    def test_ray_files_with_wrong_dtype_shape_or_header(self):
+        cases = {
+            "f64.npy": np.zeros((4, 8), dtype=np.float64),
+            "seven.npy": np.zeros((4, 7), dtype=np.float32),
+            "flat.npy": np.zeros(32, dtype=np.float32),
+            "ints.npy": np.zeros((4, 8), dtype=np.int32),
+            "fortran.npy": np.asfortranarray(np.zeros((4, 8), dtype=np.float32)),
+        }
+        for name, array in cases.items():
+            path = self.path(name)
+            np.save(path, array)
+            with self.subTest(name):
+                self.assertBadInput(self.trace(path), path)
+
+    def test_truncated_and_non_npy_files(self):
+        good = self.make_rays("primary", 100)
+        data = open(good, "rb").read()
+        truncated = self.path("truncated.npy")
+        open(truncated, "wb").write(data[:-7])
+        self.assertBadInput(self.trace(truncated), truncated, "truncated")
+        text = self.path("text.npy")
+        open(text, "w").write("0 0 0 0 0 0 1 1\n")
+        self.assertBadInput(self.trace(text), text, "not a .npy file")
+        self.assertBadInput(self.trace(self.path("absent.npy")), "absent.npy", "no such file")
+
+    def test_missing_malformed_and_empty_scenes(self):
+        rays = self.make_rays("primary", 100)
+        self.assertBadInput(self.trace(rays, scene=self.path("absent.obj")), "absent.obj", "no such file")
+        garbage = self.path("garbage.ply")
+        open(garbage, "wb").write(b"ply\nformat binary_little_endian 1.0\nelement vertex 3\n")
+        self.assertBadInput(self.trace(rays, scene=garbage), garbage)
+        broken = self.path("broken.obj")
+        open(broken, "w").write("v 0 0 0\nf 1 2 3\n")  # indices out of range
+        self.assertBadInput(self.trace(rays, scene=broken), broken)
+        self.assertBadInput(self.trace(rays, scene=POND), POND, "no triangles")
+
+    def test_unknown_backend_and_ray_set(self):
+        rays = self.make_rays("primary", 100)
+        self.assertBadInput(self.trace(rays, backend="optix"), "unknown backend 'optix'")
+        self.assertBadInput(run("rays", "--scene", SCENE, "--kind", "specular", "-o", self.path("x.npy")), "specular")
+        self.assertFalse(os.path.exists(self.path("x.npy")))
+
+    def test_usage_errors_exit_2(self):
+        self.assertBadInput(run("trace", "--scene", SCENE), "--rays")
+        self.assertBadInput(run("frobnicate"))
+        self.assertEqual(run("--help").returncode, 0)
+        self.assertEqual(run("run", "--help").returncode, 0)
+
+
+class SuiteRun(CliTestCase):
+    def test_a_small_run_writes_the_schema_and_metadata(self):
+        suite = self.path("suite.toml")
+        with open(suite, "w") as f:
+            f.write('[defaults]\nrays = 2000\nrepetitions = 2\nbuild_repetitions = 1\nmin_time = 0.01\nwarmup = 0.0\n'
+                    f'[[scene]]\nname = "terrain"\npath = "{SCENE}"\n'
+                    f'[[scene]]\nname = "wuson"\npath = "{WUSON}"\n'
+                    '[[scene]]\nname = "absent"\npath = "does/not/exist.ply"\noptional = true\n')
+        out = os.path.join(self.dir, "results", "run.csv")  # a folder the run creates
+        result = run("run", "--suite", suite, "--out", out, "--rays-dir", self.path("rays"), "--threads", "1,2")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertIn("skipping scene 'absent'", result.stderr)
+        self.assertIn("[1/2] loading terrain", result.stderr)  # progress on stderr
+        self.assertIn("x embree", result.stdout)  # the table on stdout
+        with open(out) as f:
+            rows = list(csv.DictReader(f))
+        # 2 scenes x 4 ray sets x 2 backends x 2 thread counts
+        self.assertEqual(len(rows), 32)
+        for column in ("scene", "triangles", "rayset", "rays", "backend", "threads", "build_ms", "memory_bytes",
+                       "mrays_s", "mrays_s_min", "mrays_s_max", "reps", "hit_rate", "agree_hit", "agree_prim",
+                       "t_relerr_max", "t_relerr_p999", "disagreements"):
+            self.assertIn(column, rows[0])
+        for row in rows:
+            self.assertGreater(float(row["mrays_s"]), 0)
+            self.assertLessEqual(float(row["mrays_s_min"]), float(row["mrays_s"]))
+            self.assertLessEqual(float(row["mrays_s"]), float(row["mrays_s_max"]))
+            self.assertEqual(row["reps"], "2")
+            self.assertEqual(len(row["mrays_s_samples"].split(";")), 2)
+            self.assertGreaterEqual(float(row["agree_hit"]), 0.9999, row)
+            if row["backend"] == "embree":
+                self.assertEqual(float(row["ratio_to_embree"]), 1.0)
+        with open(os.path.join(self.dir, "results", "run.meta.toml"), "rb") as f:
+            meta = tomllib.load(f)
+        for key in ("cpu", "compiler", "flags", "embree", "git_commit", "date", "threads"):
+            self.assertTrue(meta[key], key)
+        # The stored ray sets are reused by a second run: identical rays.
+        stored = sorted(os.listdir(self.path("rays")))
+        self.assertEqual(len(stored), 8)
+        again = run("run", "--suite", suite, "--out", out, "--rays-dir", self.path("rays"), "--scene", "wuson",
+                    "--rayset", "primary", "--backend", "bvh2", "--reps", "1")
+        self.assertEqual(again.returncode, 0, again.stderr)
+        self.assertIn("reusing", again.stderr)
+        self.assertEqual(sorted(os.listdir(self.path("rays"))), stored)
+
+    def test_a_bad_run_request_fails_before_writing_anything(self):
+        out = self.path("never.csv")
+        for args in (["--backend", "embree,nope"], ["--rayset", "primary,specular"], ["--scene", "no/such/mesh.obj"],
+                     ["--suite", self.path("missing.toml")]):
+            with self.subTest(args=args):
+                result = run("run", "--out", out, "--rays-dir", self.path("rays"), "--rays", "100", *args)
+                self.assertBadInput(result)
+                self.assertFalse(os.path.exists(out))
+
+
+if __name__ == "__main__":
+    unittest.main()
