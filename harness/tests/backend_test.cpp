@@ -131,14 +131,7 @@ INSTANTIATE_TEST_SUITE_P(Registry, EveryBackend, ::testing::ValuesIn(every_backe
 });
 
 TEST(BackendNames, UnknownFamiliesAndOptionsAreErrorsThatSaySo) {
-  const auto error_of = [](const std::string& name) {
-    try {
-      make_backend(name);
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  const auto error_of = [](const std::string& name) { return testing::input_error_of([&] { make_backend(name); }); };
   EXPECT_NE(error_of("optix").find("unknown backend 'optix'"), std::string::npos);
   EXPECT_NE(error_of("embree:ultra").find("unknown embree option 'ultra'"), std::string::npos);
   EXPECT_NE(error_of("bvh2:magic").find("unknown triangle test 'magic'"), std::string::npos);

@@ -29,12 +29,7 @@ std::string npy_bytes(const std::string& dict, std::size_t body_bytes, int major
 }
 
 std::string error_of(const std::string& path) {
-  try {
-    read_ray_file(path);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+  return testing::input_error_of([&] { read_ray_file(path); });
 }
 
 TEST(Npy, RayFileRoundTripsBitExactly) {

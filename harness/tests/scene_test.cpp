@@ -15,12 +15,7 @@ namespace {
 using testing::TempDir;
 
 std::string error_of(const std::string& spec) {
-  try {
-    load_scene(spec);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+  return testing::input_error_of([&] { load_scene(spec); });
 }
 
 bool same(Vec3f a, Vec3f b) { return a.x == b.x && a.y == b.y && a.z == b.z; }

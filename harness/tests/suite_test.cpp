@@ -11,12 +11,7 @@ namespace {
 using testing::TempDir;
 
 std::string error_of(const std::string& path) {
-  try {
-    load_suite(path);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+  return testing::input_error_of([&] { load_suite(path); });
 }
 
 TEST(Suite, TheDefaultSuiteParsesAndIncludesTheMillionTriangleProceduralScene) {

@@ -5,6 +5,8 @@
 #include <fstream>
 #include <string>
 
+#include "error.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -35,6 +37,17 @@ class TempDir {
   }
   std::filesystem::path path_;
 };
+
+// The message of the InputError that f() throws, or "" when it throws none.
+template <typename F>
+std::string input_error_of(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
 
 inline std::string shared_mesh(const std::string& name) { return std::string(RAYBENCH_SHARED_MESHES) + "/" + name; }
 inline std::string assimp_model(const std::string& name) { return std::string(RAYBENCH_ASSIMP_MODELS) + "/" + name; }
