@@ -50,6 +50,7 @@ class Backend {
 struct BackendInfo {
   std::string name;         // as given on the command line
   std::string description;
+  std::string accuracy = "fast";  // the accuracy class of its triangle test; "epsilon" for seed-faithful ones
 };
 
 // Makes a backend from "family[:option[:option...]]", e.g. "embree:high:robust"

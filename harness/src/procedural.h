@@ -24,8 +24,4 @@ std::vector<ProceduralSceneInfo> procedural_scenes();
 // Builds "proc:<name>"; throws InputError for an unknown name.
 Scene make_procedural_scene(const std::string& spec);
 
-// A closed UV sphere (fans at the poles, no degenerate triangles), whose
-// neighbouring triangles share bit-identical vertices.
-void append_uv_sphere(std::vector<Triangle>& out, Vec3f center, float radius, int rings, int segments);
-
 }  // namespace raybench

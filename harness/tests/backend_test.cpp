@@ -2,6 +2,7 @@
 // backend alike: known answers, untraceable rays, threads, and names.
 #include "backend.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -26,9 +27,12 @@ Scene square_scene() {
 
 Ray down(float x, float y, float tfar = kInf) { return Ray{{x, y, 1}, 0.0f, {0, 0, -1}, tfar}; }
 
-std::vector<std::string> every_backend() {
+// Every backend except the seed-faithful ones, whose documented failures
+// (e.g. hits behind the origin) are pinned below instead.
+std::vector<std::string> every_correct_backend() {
   std::vector<std::string> names;
-  for (const BackendInfo& b : list_backends()) names.push_back(b.name);
+  for (const BackendInfo& b : list_backends())
+    if (b.accuracy != "epsilon") names.push_back(b.name);
   return names;
 }
 
@@ -124,11 +128,37 @@ TEST_P(EveryBackend, TwoThreadsGiveTheSameAnswersAsOne) {
   EXPECT_EQ(hits, 10000);  // straight down onto the terrain
 }
 
-INSTANTIATE_TEST_SUITE_P(Registry, EveryBackend, ::testing::ValuesIn(every_backend()), [](const auto& info) {
+INSTANTIATE_TEST_SUITE_P(Registry, EveryBackend, ::testing::ValuesIn(every_correct_backend()), [](const auto& info) {
   std::string n = info.param;
   for (char& c : n) if (c == ':') c = '_';
   return n;
 });
+
+TEST(SeedFaithfulBackend, KnownFailure_ReportsATriangleBehindTheOrigin) {
+  // A tilted triangle whose box reaches in front of the origin (so traversal
+  // visits it) while the ray's line crosses it behind the origin, at
+  // z = -0.8, t = -0.3. seed 002's test never checks t >= 0 and reports it.
+  Scene tilted;
+  tilted.triangles = {{{0, 0, -1}, {1, 0, -1}, {0, 1, 1}}};
+  const Ray r{{0.1f, 0.1f, -0.5f}, 0.0f, {0, 0, 1}, kInf};
+  std::vector<Hit> hits(1);
+  const auto seed = make_backend("bvh2:mt_seed");
+  seed->build(tilted);
+  seed->intersect({&r, 1}, hits);
+  EXPECT_EQ(hits[0].prim, 0);
+  EXPECT_NEAR(hits[0].t, -0.3f, 1e-6f);
+  const auto fixed = make_backend("bvh2:mt");
+  fixed->build(tilted);
+  fixed->intersect({&r, 1}, hits);
+  EXPECT_FALSE(hits[0].hit());
+}
+
+TEST(BackendNames, EveryTriangleTestIsABvh2Backend) {
+  std::vector<std::string> names;
+  for (const BackendInfo& b : list_backends()) names.push_back(b.name);
+  for (const char* n : {"bvh2:mt", "bvh2:mt_seed", "bvh2:watertight", "bvh2:baldwin_weber", "bvh2:mt_double"})
+    EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
+}
 
 TEST(BackendNames, UnknownFamiliesAndOptionsAreErrorsThatSaySo) {
   const auto error_of = [](const std::string& name) { return testing::input_error_of([&] { make_backend(name); }); };

@@ -73,8 +73,8 @@ std::vector<BackendInfo> bvh2_backend_names() {
   std::vector<BackendInfo> out{{"bvh2", "our binary BVH, binned SAH build, with the default triangle test"}};
   for_each_triangle_test([&](auto test) {
     using Test = decltype(test);
-    out.push_back({"bvh2:" + std::string(Test::name),
-                   fmt::format("bvh2 with {} [{}]", Test::description, to_string(Test::accuracy))});
+    out.push_back({"bvh2:" + std::string(Test::name), fmt::format("bvh2 with {} [{}]", Test::description, to_string(Test::accuracy)),
+                   std::string(to_string(Test::accuracy))});
   });
   return out;
 }

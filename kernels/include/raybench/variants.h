@@ -6,11 +6,16 @@
 
 #include <tuple>
 
+#include "raybench/prim/triangle_baldwin_weber.h"
 #include "raybench/prim/triangle_mt.h"
+#include "raybench/prim/triangle_mt_double.h"
+#include "raybench/prim/triangle_mt_seed.h"
+#include "raybench/prim/triangle_watertight.h"
 
 namespace raybench {
 
 // The first entry is the default test of every BVH backend.
-using TriangleTests = std::tuple<MollerTrumbore>;
+using TriangleTests =
+    std::tuple<MollerTrumbore, MollerTrumboreSeed, WatertightTriangle, BaldwinWeber, MollerTrumboreDouble>;
 
 }  // namespace raybench

@@ -99,10 +99,11 @@ inline void traverse_bvh2(const Bvh2& bvh, const Ray& ray, LeafFn&& leaf) {
 template <typename Test>
 inline Hit intersect_bvh2(const Bvh2& bvh, std::span<const typename Test::Prepared> prepared, const Ray& ray) {
   Hit hit;
+  const auto& ray_data = Test::precompute(ray);
   traverse_bvh2<false>(bvh, ray, [&](std::uint32_t first, std::uint32_t count, float tmax) {
     for (std::uint32_t i = first; i < first + count; ++i) {
       TriangleHit th;
-      if (Test::intersect(ray, tmax, prepared[i], th)) {
+      if (Test::intersect(ray_data, tmax, prepared[i], th)) {
         tmax = th.t;
         hit = {th.t, static_cast<std::int32_t>(bvh.prim_ids[i]), th.u, th.v};
       }
@@ -116,10 +117,11 @@ inline Hit intersect_bvh2(const Bvh2& bvh, std::span<const typename Test::Prepar
 template <typename Test>
 inline bool occluded_bvh2(const Bvh2& bvh, std::span<const typename Test::Prepared> prepared, const Ray& ray) {
   bool found = false;
+  const auto& ray_data = Test::precompute(ray);
   traverse_bvh2<true>(bvh, ray, [&](std::uint32_t first, std::uint32_t count, float tmax) {
     for (std::uint32_t i = first; i < first + count; ++i) {
       TriangleHit th;
-      if (Test::intersect(ray, tmax, prepared[i], th)) {
+      if (Test::intersect(ray_data, tmax, prepared[i], th)) {
         found = true;
         return -std::numeric_limits<float>::infinity();
       }

@@ -17,6 +17,17 @@ struct TriangleHit {
   float t, u, v;
 };
 
+// Every ray-triangle test is a policy type with this shape (see triangle_mt.h):
+//   name, description, accuracy          what the harness and the CSV call it
+//   Prepared prepare(const Triangle&)    per-triangle data, stored by the BVH in leaf order
+//   RayData precompute(const Ray&)       per-ray data, computed once per traversal
+//   bool intersect(const RayData&, float tmax, const Prepared&, TriangleHit&)
+//                                        hit at t in (tnear, tmax]? fills the hit
+//   bool intersect(const Ray&, float tmax, const Triangle&, TriangleHit&)
+//                                        the same without precomputation (tests, tools)
+// No exceptions, no allocation; NaN input is a miss unless a seed-faithful
+// variant documents otherwise.
+
 // How far a variant's answers can be trusted; the harness reports it beside
 // each kernel so that a user reads speed next to what was traded for it.
 enum class AccuracyClass {

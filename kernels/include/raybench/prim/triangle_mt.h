@@ -30,6 +30,10 @@ struct MollerTrumbore {
   };
   static Prepared prepare(const Triangle& tri) { return {tri.v0, tri.v1 - tri.v0, tri.v2 - tri.v0}; }
 
+  // Nothing to precompute per ray.
+  using RayData = Ray;
+  static const Ray& precompute(const Ray& ray) { return ray; }
+
   // True when the ray hits the triangle at t in (ray.tnear, tmax]; fills out.
   static bool intersect(const Ray& ray, float tmax, const Prepared& tri, TriangleHit& out) {
     const Vec3f p = cross(ray.dir, tri.e2);

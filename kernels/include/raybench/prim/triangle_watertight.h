@@ -1,0 +1,88 @@
+// Watertight ray-triangle intersection: Woop, Benthin & Wald, "Watertight
+// Ray/Triangle Intersection", JCGT 2(1), 2013.
+//
+// The ray is made the +z axis of a sheared frame (per ray: the dominant
+// direction axis kz, the two others kx, ky, swapped when dir[kz] < 0 to keep
+// the winding, and the shear Sx, Sy, Sz). In that frame the test is a 2-D
+// point-in-triangle test at the origin with the scaled barycentrics
+// U, V, W computed as 2x2 determinants. Neighbouring triangles evaluate the
+// same determinant for a shared edge (with opposite sign), so a ray through
+// a shared edge or vertex hits at least one of them: no cracks. When a
+// determinant is exactly 0 in float it is recomputed in double (the paper's
+// fallback), so the edge decision is exact for these inputs.
+// Not culled: both faces hit. Degenerate triangles (U+V+W == 0) miss.
+#pragma once
+
+#include <cmath>
+#include <string_view>
+
+#include "raybench/math/ray.h"
+#include "raybench/prim/triangle.h"
+
+namespace raybench {
+
+struct WatertightTriangle {
+  static constexpr std::string_view name = "watertight";
+  static constexpr std::string_view description = "Woop, Benthin & Wald 2013 (JCGT): sheared frame, no cracks on shared edges";
+  static constexpr AccuracyClass accuracy = AccuracyClass::kWatertight;
+
+  using Prepared = Triangle;
+  static Prepared prepare(const Triangle& tri) { return tri; }
+
+  struct RayData {
+    Vec3f org;
+    float tnear;
+    int kx, ky, kz;
+    float sx, sy, sz;
+  };
+  static RayData precompute(const Ray& ray) {
+    RayData r;
+    r.org = ray.org;
+    r.tnear = ray.tnear;
+    const float ax = std::fabs(ray.dir.x), ay = std::fabs(ray.dir.y), az = std::fabs(ray.dir.z);
+    r.kz = (ax >= ay && ax >= az) ? 0 : (ay >= az ? 1 : 2);
+    r.kx = (r.kz + 1) % 3;
+    r.ky = (r.kx + 1) % 3;
+    if (ray.dir[r.kz] < 0.0f) std::swap(r.kx, r.ky);  // keep the winding
+    r.sx = ray.dir[r.kx] / ray.dir[r.kz];
+    r.sy = ray.dir[r.ky] / ray.dir[r.kz];
+    r.sz = 1.0f / ray.dir[r.kz];
+    return r;
+  }
+
+  static bool intersect(const RayData& r, float tmax, const Triangle& tri, TriangleHit& out) {
+    const Vec3f a = tri.v0 - r.org, b = tri.v1 - r.org, c = tri.v2 - r.org;
+    const float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
+    const float bx = b[r.kx] - r.sx * b[r.kz], by = b[r.ky] - r.sy * b[r.kz];
+    const float cx = c[r.kx] - r.sx * c[r.kz], cy = c[r.ky] - r.sy * c[r.kz];
+    float u = cx * by - cy * bx;  // weight of v0
+    float v = ax * cy - ay * cx;  // weight of v1
+    float w = bx * ay - by * ax;  // weight of v2
+    if (u == 0.0f || v == 0.0f || w == 0.0f) {
+      // On an edge in float: decide in double, where these products are exact.
+      u = static_cast<float>(static_cast<double>(cx) * by - static_cast<double>(cy) * bx);
+      v = static_cast<float>(static_cast<double>(ax) * cy - static_cast<double>(ay) * cx);
+      w = static_cast<float>(static_cast<double>(bx) * ay - static_cast<double>(by) * ax);
+    }
+    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
+    const float det = u + v + w;
+    if (!(det != 0.0f)) return false;  // degenerate (or NaN)
+    const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
+    const float t_scaled = u * az + v * bz + w * cz;
+    // tnear < t <= tmax, without dividing: the paper's sign-aware comparison.
+    if (det > 0.0f) {
+      if (!(t_scaled > r.tnear * det && t_scaled <= tmax * det)) return false;
+    } else {
+      if (!(t_scaled < r.tnear * det && t_scaled >= tmax * det)) return false;
+    }
+    const float inv_det = 1.0f / det;
+    out = {t_scaled * inv_det, v * inv_det, w * inv_det};
+    // tmax * det may round: keep the exact interval on the divided t.
+    return out.t > r.tnear && out.t <= tmax;
+  }
+  static bool intersect(const Ray& ray, float tmax, const Triangle& tri, TriangleHit& out) {
+    return intersect(precompute(ray), tmax, tri, out);
+  }
+};
+
+}  // namespace raybench
