@@ -11,6 +11,7 @@
 #include "build_info.h"
 #include "backend.h"
 #include "error.h"
+#include "kernel_bench.h"
 #include "metadata.h"
 #include "npy.h"
 #include "procedural.h"
@@ -131,6 +132,19 @@ int run(int argc, char** argv) {
   trace_cmd->add_option("--threads,-t", trace_threads, "Threads")->capture_default_str()->check(CLI::PositiveNumber);
   trace_cmd->add_option("--suite", trace_suite, "Suite manifest to look scene names up in")->capture_default_str();
 
+  // raybench kernels
+  KernelBenchOptions kernel_options;
+  kernel_options.out_csv = std::string(RAYBENCH_SOURCE_DIR) + "/results/kernels.csv";
+  kernel_options.out_json = std::string(RAYBENCH_SOURCE_DIR) + "/results/kernels.json";
+  CLI::App* kernels_cmd = app.add_subcommand(
+      "kernels", "Microbenchmark every kernel variant alone: ns per ray-primitive test, hit- and miss-heavy, scalar and 8-wide");
+  kernels_cmd->add_option("--out,-o", kernel_options.out_csv, "Results CSV (+ .meta.toml beside it)")->capture_default_str();
+  kernels_cmd->add_option("--json", kernel_options.out_json, "Google Benchmark JSON output ('' for none)")->capture_default_str();
+  kernels_cmd->add_option("--filter", kernel_options.filter, "Only cases whose name contains this, e.g. triangle/ or /miss");
+  kernels_cmd->add_option("--reps", kernel_options.repetitions, "Timed repetitions per case")->capture_default_str()->check(CLI::PositiveNumber);
+  kernels_cmd->add_option("--min-time", kernel_options.min_time, "Minimum seconds per repetition")->capture_default_str()->check(CLI::PositiveNumber);
+  kernels_cmd->add_option("--pairs", kernel_options.pairs, "Ray-primitive pairs per family and input")->capture_default_str();
+
   // raybench backends / scenes
   CLI::App* backends_cmd = app.add_subcommand("backends", "List backend names");
   std::string scenes_suite = kDefaultSuite;
@@ -145,6 +159,14 @@ int run(int argc, char** argv) {
     return 2;
   }
 
+  if (*kernels_cmd) {
+    kernel_options.command_line = command_line(argc, argv);
+    const std::vector<KernelResult> results = run_kernel_benchmarks(kernel_options);
+    std::cout << format_kernel_table(results);
+    fmt::print("results: {} ({} rows){}\n", kernel_options.out_csv, results.size(),
+               kernel_options.out_json.empty() ? "" : ", Google Benchmark JSON: " + kernel_options.out_json);
+    return 0;
+  }
   if (*backends_cmd) {
     for (const BackendInfo& b : list_backends()) fmt::print("{:<20} {}\n", b.name, b.description);
     return 0;

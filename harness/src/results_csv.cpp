@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "atomic_file.h"
 #include "error.h"
@@ -63,8 +64,7 @@ void write_results_csv(const std::string& path, const std::vector<ResultRow>& ro
     for (std::size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << columns[i];
     out << '\n';
     for (const ResultRow& r : rows) {
-      std::string samples;
-      for (double s : r.mrays_s_samples) samples += (samples.empty() ? "" : ";") + fmt::format("{:.6g}", s);
+      const std::string samples = fmt::format("{:.6g}", fmt::join(r.mrays_s_samples, ";"));
       out << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", text(r.scene),
                          r.triangles, text(r.rayset), r.query, r.rays, text(r.backend), r.threads, number(r.build_ms),
                          number(r.build_ms_min), number(r.build_ms_max), r.memory_bytes, number(r.mrays_s),

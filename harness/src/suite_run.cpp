@@ -14,6 +14,7 @@
 #include "agreement.h"
 #include "backend.h"
 #include "error.h"
+#include "gbench.h"
 #include "metadata.h"
 #include "npy.h"
 #include "rayset.h"
@@ -24,13 +25,6 @@ namespace raybench {
 namespace {
 
 void progress(const std::string& line) { std::cerr << "raybench: " << line << std::endl; }
-
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 struct LoadedScene {
   const SuiteScene* entry = nullptr;  // null for a scene given by path
@@ -66,49 +60,6 @@ std::vector<Ray> obtain_rays(const RayGenerator& generator, const Scene& scene, 
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   progress(fmt::format("  {} rays: generated {} in {:.0f} ms -> {}", to_string(spec.kind), rays.size(), ms, path));
   return rays;
-}
-
-// Collects every repetition of every case; prints progress as cases finish.
-class CollectingReporter : public benchmark::BenchmarkReporter {
- public:
-  explicit CollectingReporter(std::size_t total) : total_(total) {}
-  bool ReportContext(const Context&) override { return true; }
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& run : runs) {
-      if (run.run_type != Run::RT_Iteration) continue;
-      const std::string& name = run.run_name.function_name;
-      if (run.error_occurred) {
-        errors_[name] = run.error_message;
-        continue;
-      }
-      samples_[name].push_back(run.counters.at("rays").value / 1e6);
-    }
-    // Google Benchmark reports a case twice: its repetitions, then aggregates.
-    if (!runs.empty() && runs.front().run_type == Run::RT_Iteration) {
-      const std::string& name = runs.front().run_name.function_name;
-      const auto& s = samples_[name];
-      progress(fmt::format("  [{}/{}] {}: {:.2f} Mrays/s (median of {})", ++done_, total_, name, median(s), s.size()));
-    }
-  }
-  void Finalize() override {}
-  const std::vector<double>& samples(const std::string& name) { return samples_[name]; }
-  const std::map<std::string, std::string>& errors() const { return errors_; }
-
- private:
-  std::size_t total_, done_ = 0;
-  std::map<std::string, std::vector<double>> samples_;
-  std::map<std::string, std::string> errors_;
-};
-
-void initialize_google_benchmark(bool interleave) {
-  static bool initialized = false;
-  if (initialized) return;
-  initialized = true;
-  std::string arg0 = "raybench";
-  std::string interleaving = fmt::format("--benchmark_enable_random_interleaving={}", interleave ? "true" : "false");
-  char* argv[] = {arg0.data(), interleaving.data(), nullptr};
-  int argc = 2;
-  benchmark::Initialize(&argc, argv);
 }
 
 LoadedScene load(const RunOptions& options, const std::string& name_or_path) {
@@ -150,7 +101,8 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
                              : ""));
   }
 
-  initialize_google_benchmark(options.interleave);
+  initialize_google_benchmark(
+      {fmt::format("--benchmark_enable_random_interleaving={}", options.interleave ? "true" : "false")});
   std::vector<ResultRow> rows;
   for (std::size_t si = 0; si < scenes.size(); ++si) {
     const Scene& scene = scenes[si].scene;
@@ -275,14 +227,11 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
     }
     progress(fmt::format("[{}/{}] {}: timing {} cases x {} repetitions", si + 1, scenes.size(), scene.name, cases.size(),
                          settings.repetitions));
-    CollectingReporter reporter(cases.size());
+    CollectingReporter reporter("rays", 1e-6, "Mrays/s", cases.size());
     benchmark::RunSpecifiedBenchmarks(&reporter);
     benchmark::ClearRegisteredBenchmarks();
     for (Case& c : cases) {
-      if (auto e = reporter.errors().find(c.name); e != reporter.errors().end())
-        throw std::runtime_error(c.name + ": benchmark failed: " + e->second);
       const std::vector<double>& s = reporter.samples(c.name);
-      if (s.empty()) throw std::runtime_error(c.name + ": benchmark produced no measurement");
       c.row.mrays_s_samples = s;
       c.row.reps = static_cast<int>(s.size());
       c.row.mrays_s = median(s);

@@ -5,6 +5,7 @@ exit status 2, and no result file.
 Run through ctest (harness/tests/CMakeLists.txt sets RAYBENCH and the mesh folders).
 """
 import csv
+import json
 import os
 import subprocess
 import tempfile
@@ -219,6 +220,40 @@ class SuiteRun(CliTestCase):
                 result = run("run", "--out", out, "--rays-dir", self.path("rays"), "--rays", "100", *args)
                 self.assertBadInput(result)
                 self.assertFalse(os.path.exists(out))
+
+
+class KernelMicrobenchmarks(CliTestCase):
+    def test_every_variant_is_timed_and_written_as_csv_and_json(self):
+        out, js = self.path("k.csv"), self.path("k.json")
+        result = run("kernels", "--reps", "1", "--min-time", "0.001", "--pairs", "64", "--out", out, "--json", js)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        with open(out) as f:
+            rows = list(csv.DictReader(f))
+        names = {(r["family"], r["variant"], r["form"], r["input"]) for r in rows}
+        variants = {"triangle": ["mt", "mt_seed", "watertight", "baldwin_weber", "mt_double"],
+                    "box": ["slab", "slab_seed", "slab_robust"],
+                    "sphere": ["sphere_seed", "sphere_quadratic", "sphere_precise"],
+                    "obb": ["obb", "obb_seed"]}
+        for family, members in variants.items():
+            for variant in members:
+                for kind in ("hit", "miss"):
+                    self.assertIn((family, variant, "scalar", kind), names)
+        for family, variant in (("triangle", "mt"), ("box", "slab")):
+            for kind in ("hit", "miss"):
+                self.assertIn((family, variant, "scalar_x8", kind), names)
+        for row in rows:
+            self.assertGreater(float(row["ns_per_test"]), 0)
+            # Inputs are classified by each family's most accurate variant:
+            # a correct variant answers like it on these ordinary rays.
+            if row["accuracy"] != "epsilon":
+                self.assertAlmostEqual(float(row["hit_fraction"]), 1.0 if row["input"] == "hit" else 0.0, delta=0.02)
+        with open(js) as f:
+            self.assertEqual(len(json.load(f)["benchmarks"]), len(rows))
+        self.assertTrue(os.path.exists(self.path("k.meta.toml")))
+
+    def test_a_filter_that_matches_nothing_is_an_error(self):
+        self.assertBadInput(run("kernels", "--filter", "teapot", "--out", self.path("k.csv"), "--json", ""), "teapot")
+        self.assertFalse(os.path.exists(self.path("k.csv")))
 
 
 if __name__ == "__main__":

@@ -46,12 +46,6 @@ class Bvh2Backend final : public Backend {
   std::vector<typename Test::Prepared> prepared_;
 };
 
-// Calls f.template operator()<Test>() for each type of TriangleTests.
-template <typename F>
-void for_each_triangle_test(F&& f) {
-  std::apply([&](auto... tests) { (f(tests), ...); }, TriangleTests{});
-}
-
 }  // namespace
 
 std::unique_ptr<Backend> make_bvh2_backend(const std::string& name, const std::vector<std::string>& options,
@@ -60,7 +54,7 @@ std::unique_ptr<Backend> make_bvh2_backend(const std::string& name, const std::v
   const std::string wanted = options.empty() ? std::string(std::tuple_element_t<0, TriangleTests>::name) : options[0];
   std::unique_ptr<Backend> made;
   std::string known;
-  for_each_triangle_test([&](auto test) {
+  for_each_variant<TriangleTests>([&](auto test) {
     using Test = decltype(test);
     known += (known.empty() ? "" : ", ") + std::string(Test::name);
     if (Test::name == wanted) made = std::make_unique<Bvh2Backend<Test>>(name);
@@ -71,7 +65,7 @@ std::unique_ptr<Backend> make_bvh2_backend(const std::string& name, const std::v
 
 std::vector<BackendInfo> bvh2_backend_names() {
   std::vector<BackendInfo> out{{"bvh2", "our binary BVH, binned SAH build, with the default triangle test"}};
-  for_each_triangle_test([&](auto test) {
+  for_each_variant<TriangleTests>([&](auto test) {
     using Test = decltype(test);
     out.push_back({"bvh2:" + std::string(Test::name), fmt::format("bvh2 with {} [{}]", Test::description, to_string(Test::accuracy)),
                    std::string(to_string(Test::accuracy))});

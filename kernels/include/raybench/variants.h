@@ -1,10 +1,19 @@
 // The one list of kernel variants. The harness registers a backend per entry
 // (bvh2:<name>), the typed tests run over it, and benchmark names come from
-// each type's `name`. Adding a ray-triangle test means writing its header in
-// prim/ and adding its type here; nothing else changes.
+// each type's `name`. Adding a kernel variant means writing its header in
+// prim/ and adding its type to its family's list here; nothing else changes.
 #pragma once
 
 #include <tuple>
+
+#include "raybench/prim/aabb_slab.h"
+#include "raybench/prim/aabb_slab_robust.h"
+#include "raybench/prim/aabb_slab_seed.h"
+#include "raybench/prim/obb_eigen.h"
+#include "raybench/prim/obb_seed.h"
+#include "raybench/prim/sphere_precise.h"
+#include "raybench/prim/sphere_quadratic.h"
+#include "raybench/prim/sphere_seed.h"
 
 #include "raybench/prim/triangle_baldwin_weber.h"
 #include "raybench/prim/triangle_mt.h"
@@ -17,5 +26,17 @@ namespace raybench {
 // The first entry is the default test of every BVH backend.
 using TriangleTests =
     std::tuple<MollerTrumbore, MollerTrumboreSeed, WatertightTriangle, BaldwinWeber, MollerTrumboreDouble>;
+
+// Ray-box tests (seed 000), ray-sphere tests (seed 003), ray-OBB tests
+// (seed 004). The microbenchmarks (raybench kernels) time every entry.
+using BoxTests = std::tuple<Slab, SlabSeed, SlabRobust>;
+using SphereTests = std::tuple<SpherePrecise, SphereSeed, SphereQuadratic>;
+using ObbTests = std::tuple<Obb, ObbSeed>;
+
+// Calls f(Variant{}) for each type of a tuple of variants.
+template <typename Variants, typename F>
+void for_each_variant(F&& f) {
+  std::apply([&](auto... variants) { (f(variants), ...); }, Variants{});
+}
 
 }  // namespace raybench

@@ -9,7 +9,8 @@
 // a culling test, not a surface hit: closing both ends keeps a primitive
 // lying exactly at tnear or tmax reachable, and the primitive test decides.
 // On a hit, out is the overlap of that interval with the box's interval
-// along the ray; on a miss out is left untouched (as the triangle tests do).
+// along the ray (SlabRobust pads t_exit by its error bound); on a miss out is
+// left untouched (as the triangle tests do).
 #pragma once
 
 #include "raybench/math/bbox.h"

@@ -26,7 +26,8 @@
 // - The ray's tnear is honoured; the interval is closed at both ends.
 // - An entry at +inf is a miss: the ray never gets there (a zero component
 //   with the origin outside that slab, when every other bound is infinite).
-// The empty box (lower = +inf, upper = -inf) is missed.
+// The empty box (lower = +inf, upper = -inf) is missed. A NaN box coordinate
+// gives a NaN distance, ignored like the others: that side is unbounded.
 //
 // Not conservative: every distance is rounded (three roundings, see
 // aabb_slab_robust.h), so a box the exact ray only grazes may be missed.

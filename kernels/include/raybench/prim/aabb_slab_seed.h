@@ -2,9 +2,9 @@
 // that shows what aabb_slab.h and aabb_slab_robust.h fix.
 //
 // Source: ../shared/seeds/000_*.txt (i_dovelemon, "3D空间中射线与轴向包围盒AABB的
-// 交叉检测算法", blog.csdn.net/i_dovelemon/article/details/38342739; the
-// slabs method of Real-Time Collision Detection §5.3.3). Per axis, in the
-// order x, y, z:
+// 交叉检测算法", blog.csdn.net/i_dovelemon/article/details/38342739; it follows
+// the slabs method of Ericson's Real-Time Collision Detection, which it
+// cites). Per axis, in the order x, y, z:
 //   |d| < 0.000001f         "parallel": miss if the origin is outside the slab
 //   else t1, t2 = (min - o) * (1/d), (max - o) * (1/d), swapped so t1 <= t2
 //        tmin = max(tmin, t1), tmax = min(tmax, t2), miss if tmin > tmax
