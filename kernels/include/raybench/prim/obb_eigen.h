@@ -18,9 +18,11 @@
 //   This is also what is_traceable (math/ray.h) screens.
 //
 // Semantics: true when a point of the closed box lies at t in [tnear, tmax];
-// out gets the unclipped interval {entry, exit}. An origin inside has
-// entry < 0 <= exit: the exit is where the ray leaves the box. The axes must
-// be orthonormal (the rotation is their transpose, never inverted).
+// out gets that part of the ray, [max(entry, tnear), min(exit, tmax)], as
+// BoxHit promises for every box test (aabb.h). An origin inside has a slab
+// entry < 0, so it enters at tnear and the exit is where it leaves the box.
+// On a miss out is untouched. The axes must be orthonormal (the rotation is
+// their transpose, never inverted).
 // Precision: the frame change and the slabs run in double (not a hot loop,
 // and a float rotation would round the origin onto or off a face), so only
 // the final distances are rounded to float.
@@ -31,7 +33,14 @@
 #include <string_view>
 #include <utility>
 
+// Eigen 3.4's AVX PacketMath.h has an unused variable (F32ToBf16) that
+// -Wall reports when Eigen is included with -I rather than as a system
+// header (CMake's Eigen3::Eigen target uses -isystem): silence it for Eigen
+// only, not for this file.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-variable"
 #include <Eigen/Dense>
+#pragma GCC diagnostic pop
 
 #include "raybench/math/ray.h"
 #include "raybench/prim/obb.h"
@@ -65,8 +74,9 @@ struct Obb {
         if (!(org[i] >= -half[i] && org[i] <= half[i])) return false;
         continue;  // parallel, inside the closed slab: it does not narrow the interval
       }
-      // Division, not a reciprocal: finite over finite nonzero, never NaN;
-      // a tiny component overflows to +-inf, which orders correctly.
+      // Division, not a reciprocal: finite over finite nonzero, never NaN. In
+      // double even a denormal float component gives a finite t; only the
+      // float in out can round to +-inf, which still orders correctly.
       double t_lo = (-half[i] - org[i]) / dir[i];
       double t_hi = (half[i] - org[i]) / dir[i];
       if (t_lo > t_hi) std::swap(t_lo, t_hi);
@@ -77,7 +87,7 @@ struct Obb {
     const double lo = entry > ray.tnear ? entry : static_cast<double>(ray.tnear);
     const double hi = exit < tmax ? exit : static_cast<double>(tmax);
     if (!(lo <= hi)) return false;
-    out = {static_cast<float>(entry), static_cast<float>(exit)};
+    out = {static_cast<float>(lo), static_cast<float>(hi)};
     return true;
   }
 };

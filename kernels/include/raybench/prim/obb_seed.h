@@ -25,7 +25,8 @@
 // stores a box's full size m_size; m_size / 2.0 is half_extent exactly.
 // The one adaptation: the note has no interval and returns only a bool.
 // raybench's [tnear, tmax] is applied at the end as two more rejections in
-// the note's style (NaN still passes), and out gets {minT, maxT}: for an
+// the note's style (NaN still passes), and out gets the note's {minT, maxT},
+// not clipped to [tnear, tmax] as aabb.h's BoxHit contract asks: for an
 // origin inside, the entry is the note's DBL_MIN, which rounds to 0.0f.
 #pragma once
 

@@ -9,9 +9,10 @@
 //    l = f - (b/a) d is the vector from the centre to its projection on the
 //    ray: its length is the centre-ray distance, computed by one subtraction
 //    of vectors instead of subtracting squares, so the error is ~ulp(|f|) in
-//    a length, not ~ulp(|f|^2) in a squared length. The chapter measures
-//    hit/miss errors for 0.2 % of rays at distance 1e6 (EXTREMES.md G12),
-//    where the textbook form is wrong for about half of them from 1e4 on.
+//    a length, not ~ulp(|f|^2) in a squared length. Hit/miss is then wrong
+//    only within ~ulp(|f|) of tangent: 0.2 % of rays at distance 1e6 from a
+//    unit sphere (EXTREMES.md G12), where the textbook form is wrong for about
+//    half of them from 1e4 on (sphere_test.cpp has the rays).
 // 2. The roots (eq. 7.7): -b -/+ sqrt(D) cancels for one of them; instead
 //    q = -b - sign(b) sqrt(D) adds numbers of one sign, and the roots are
 //    c/q and q/a (their product is c/a). The near root stays accurate when
