@@ -265,14 +265,14 @@ void add_batched(std::vector<Case>& cases, std::size_t pairs) {
       };
       cases.push_back(std::move(c));
     };
-    const auto box_case = [&](const char* form, unsigned (*fn)(const RayBoxPrecomputed&, float, const BBox8&, float*)) {
+    const auto box_case = [&](const char* form, unsigned (*fn)(const Slab::Precomputed&, float, const BBox8&, float*)) {
       Case c;
       c.result = describe("box", "slab", form, hit, "fast", 8 * rays);
       c.run = [box_rays, boxes, fn] {
         std::size_t hits = 0;
         alignas(32) float entry[8];
         for (std::size_t i = 0; i < box_rays->size(); ++i)
-          hits += static_cast<std::size_t>(__builtin_popcount(fn(RayBoxPrecomputed((*box_rays)[i]), kInf, (*boxes)[i], entry)));
+          hits += static_cast<std::size_t>(__builtin_popcount(fn(Slab::precompute((*box_rays)[i]), kInf, (*boxes)[i], entry)));
         return hits;
       };
       cases.push_back(std::move(c));

@@ -153,10 +153,29 @@ TEST(SeedFaithfulBackend, KnownFailure_ReportsATriangleBehindTheOrigin) {
   EXPECT_FALSE(hits[0].hit());
 }
 
+TEST(RobustTraversal, WatertightThroughTheTreeNoRayLeaksFromInsideAClosedMesh) {
+  // The closed sphere, rays from its centre aimed exactly at every vertex and
+  // edge midpoint: the watertight test with conservative traversal lets none
+  // through (the brute-force version of this is in triangle_variants_test).
+  Scene sphere = load_scene("proc:sphere");
+  std::vector<Ray> rays;
+  for (const Triangle& t : sphere.triangles)
+    for (Vec3f target : {t.v0, (t.v0 + t.v1) * 0.5f, (t.v1 + t.v2) * 0.5f, (t.v2 + t.v0) * 0.5f})
+      rays.push_back({{0, 0, 0}, 0.0f, target, kInf});
+  const auto backend = make_backend("bvh2:watertight:robust");
+  backend->build(sphere);
+  std::vector<Hit> hits(rays.size());
+  backend->intersect(rays, hits);
+  std::size_t leaks = 0;
+  for (const Hit& h : hits) leaks += !h.hit();
+  EXPECT_EQ(leaks, 0u);
+}
+
 TEST(BackendNames, EveryTriangleTestIsABvh2Backend) {
   std::vector<std::string> names;
   for (const BackendInfo& b : list_backends()) names.push_back(b.name);
-  for (const char* n : {"bvh2:mt", "bvh2:mt_seed", "bvh2:watertight", "bvh2:baldwin_weber", "bvh2:mt_double"})
+  for (const char* n : {"bvh2:mt", "bvh2:mt_seed", "bvh2:watertight", "bvh2:baldwin_weber", "bvh2:mt_double",
+                        "bvh2:watertight:robust"})
     EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
 }
 
@@ -166,6 +185,8 @@ TEST(BackendNames, UnknownFamiliesAndOptionsAreErrorsThatSaySo) {
   EXPECT_NE(error_of("embree:ultra").find("unknown embree option 'ultra'"), std::string::npos);
   EXPECT_NE(error_of("bvh2:magic").find("unknown triangle test 'magic'"), std::string::npos);
   EXPECT_NO_THROW(make_backend("embree:high:robust"));
+  EXPECT_NO_THROW(make_backend("bvh2:robust"));  // the default triangle test, robust traversal
+  EXPECT_NE(error_of("bvh2:mt:watertight").find("bvh2 takes a triangle test"), std::string::npos);
 }
 
 }  // namespace

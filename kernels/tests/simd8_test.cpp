@@ -82,7 +82,7 @@ TEST(Box8, Avx2AnswersExactlyAsTheScalarSlabTest) {
       r.dir = {0.0f, i % 2 ? 0.0f : -0.0f, 1.0f};
       r.org.x = boxes[0].lower.x;
     }
-    const RayBoxPrecomputed pre(r);
+    const Slab::Precomputed pre = Slab::precompute(r);
     alignas(32) float e_simd[8], e_scalar[8];
     const unsigned m_simd = intersect8_avx2(pre, kInf, packed, e_simd);
     const unsigned m_scalar = intersect8_scalar(pre, kInf, packed, e_scalar);
@@ -100,7 +100,7 @@ TEST(Box8, Avx2AnswersExactlyAsTheScalarSlabTest) {
 TEST(Box8, EmptyLanesAreMissed) {
   const std::vector<BBox> one{BBox{{0, 0, 0}, {1, 1, 1}}};
   alignas(32) float entry[8];
-  const RayBoxPrecomputed r(Ray{{0.5f, 0.5f, -1}, 0, {0, 0, 1}, kInf});
+  const Slab::Precomputed r = Slab::precompute(Ray{{0.5f, 0.5f, -1}, 0, {0, 0, 1}, kInf});
   EXPECT_EQ(intersect8(r, kInf, BBox8::pack(one), entry), 1u);
   EXPECT_FLOAT_EQ(entry[0], 1.0f);
 }

@@ -1,5 +1,8 @@
 // Our binary BVH (binned SAH) with a ray-triangle test chosen by name from
-// raybench/variants.h: "bvh2" uses the first entry, "bvh2:<test>" any of them.
+// raybench/variants.h: "bvh2" uses the first entry, "bvh2:<test>" any of them;
+// a "robust" option ("bvh2:watertight:robust") traverses with the
+// conservative box test (SlabRobust), which never culls a box the exact ray
+// touches, so a watertight triangle test stays watertight through the tree.
 #include <tuple>
 
 #include <fmt/format.h>
@@ -7,12 +10,13 @@
 #include "backends/backend_families.h"
 #include "error.h"
 #include "raybench/bvh/bvh2_traverse.h"
+#include "raybench/prim/aabb_slab_robust.h"
 #include "raybench/variants.h"
 
 namespace raybench {
 namespace {
 
-template <typename Test>
+template <typename Test, typename BoxTest>
 class Bvh2Backend final : public Backend {
  public:
   explicit Bvh2Backend(std::string name) : name_(std::move(name)) {}
@@ -32,12 +36,12 @@ class Bvh2Backend final : public Backend {
 
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
     for (std::size_t i = 0; i < rays.size(); ++i)
-      hits[i] = is_traceable(rays[i]) ? intersect_bvh2<Test>(bvh_, prepared_, with_nonnegative_tnear(rays[i])) : Hit{};
+      hits[i] = is_traceable(rays[i]) ? intersect_bvh2<Test, BoxTest>(bvh_, prepared_, with_nonnegative_tnear(rays[i])) : Hit{};
   }
 
   void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override {
     for (std::size_t i = 0; i < rays.size(); ++i)
-      occluded[i] = is_traceable(rays[i]) && occluded_bvh2<Test>(bvh_, prepared_, with_nonnegative_tnear(rays[i]));
+      occluded[i] = is_traceable(rays[i]) && occluded_bvh2<Test, BoxTest>(bvh_, prepared_, with_nonnegative_tnear(rays[i]));
   }
 
  private:
@@ -50,14 +54,27 @@ class Bvh2Backend final : public Backend {
 
 std::unique_ptr<Backend> make_bvh2_backend(const std::string& name, const std::vector<std::string>& options,
                                            const BackendConfig&) {
-  if (options.size() > 1) throw InputError("", fmt::format("backend '{}': bvh2 takes one option, the triangle test", name));
-  const std::string wanted = options.empty() ? std::string(std::tuple_element_t<0, TriangleTests>::name) : options[0];
+  std::string wanted = std::string(std::tuple_element_t<0, TriangleTests>::name);
+  bool robust = false, test_named = false;
+  for (const std::string& o : options) {
+    if (o == "robust" && !robust) {
+      robust = true;
+    } else if (!test_named && o != "robust") {
+      wanted = o;
+      test_named = true;
+    } else {
+      throw InputError("", fmt::format("backend '{}': bvh2 takes a triangle test and optionally 'robust', "
+                                       "e.g. bvh2:watertight:robust", name));
+    }
+  }
   std::unique_ptr<Backend> made;
   std::string known;
   for_each_variant<TriangleTests>([&](auto test) {
     using Test = decltype(test);
     known += (known.empty() ? "" : ", ") + std::string(Test::name);
-    if (Test::name == wanted) made = std::make_unique<Bvh2Backend<Test>>(name);
+    if (Test::name != wanted) return;
+    if (robust) made = std::make_unique<Bvh2Backend<Test, SlabRobust>>(name);
+    else made = std::make_unique<Bvh2Backend<Test, Slab>>(name);
   });
   if (!made) throw InputError("", fmt::format("backend '{}': unknown triangle test '{}' (known: {})", name, wanted, known));
   return made;
@@ -70,6 +87,8 @@ std::vector<BackendInfo> bvh2_backend_names() {
     out.push_back({"bvh2:" + std::string(Test::name), fmt::format("bvh2 with {} [{}]", Test::description, to_string(Test::accuracy)),
                    std::string(to_string(Test::accuracy))});
   });
+  out.push_back({"bvh2:watertight:robust", "bvh2:<test>:robust traverses with the conservative box test (slab_robust)",
+                 "watertight"});
   return out;
 }
 

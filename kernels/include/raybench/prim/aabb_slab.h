@@ -39,6 +39,7 @@
 #include <limits>
 #include <string_view>
 
+#include "raybench/math/inline.h"
 #include "raybench/prim/aabb.h"
 
 namespace raybench {
@@ -70,7 +71,7 @@ struct Slab {
 
   // The overlap of [tnear, tmax] with the three slab intervals, as computed:
   // empty when !(t_entry <= t_exit). Shared with SlabRobust, which pads it.
-  static BoxHit clip(const Precomputed& r, const BBox& box, float tmax) {
+  RAYBENCH_INLINE static BoxHit clip(const Precomputed& r, const BBox& box, float tmax) {
     float entry = r.tnear, exit = tmax;
     for (int axis = 0; axis < 3; ++axis) {
       const float near_plane = r.negative[axis] ? box.upper[axis] : box.lower[axis];
@@ -89,7 +90,7 @@ struct Slab {
     return h.t_entry <= h.t_exit && h.t_entry < std::numeric_limits<float>::infinity();
   }
 
-  static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
+  RAYBENCH_INLINE static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
     const BoxHit h = clip(ray, box, tmax);
     if (!overlaps(h)) return false;
     out = h;

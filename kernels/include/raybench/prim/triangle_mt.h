@@ -14,6 +14,7 @@
 
 #include <string_view>
 
+#include "raybench/math/inline.h"
 #include "raybench/math/ray.h"
 #include "raybench/prim/triangle.h"
 
@@ -35,7 +36,7 @@ struct MollerTrumbore {
   static const Ray& precompute(const Ray& ray) { return ray; }
 
   // True when the ray hits the triangle at t in (ray.tnear, tmax]; fills out.
-  static bool intersect(const Ray& ray, float tmax, const Prepared& tri, TriangleHit& out) {
+  RAYBENCH_INLINE static bool intersect(const Ray& ray, float tmax, const Prepared& tri, TriangleHit& out) {
     const Vec3f p = cross(ray.dir, tri.e2);
     const float det = dot(tri.e1, p);
     if (!(det != 0.0f)) return false;  // parallel ray or zero-area triangle (or NaN)

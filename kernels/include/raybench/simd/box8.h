@@ -1,6 +1,6 @@
-// One ray against 8 axis-aligned boxes at once: the slab test of
-// bvh/bvh2_traverse.h (enter_box: planes chosen by the direction's sign, a
-// NaN distance leaves the bound unchanged) over boxes stored
+// One ray against 8 axis-aligned boxes at once: the Slab test of
+// prim/aabb_slab.h (planes chosen by the direction's sign, a NaN distance
+// leaves the bound unchanged, a NaN bound misses) over boxes stored
 // structure-of-arrays, as BVH8 nodes store their children (issue 4).
 // AVX2 when the compiler targets it, else a scalar loop, same answers.
 #pragma once
@@ -9,7 +9,7 @@
 #include <limits>
 #include <span>
 
-#include "raybench/bvh/bvh2_traverse.h"
+#include "raybench/prim/aabb_slab.h"
 #include "raybench/simd/triangle8.h"  // kHaveAvx2 and <immintrin.h>
 
 namespace raybench {
@@ -31,8 +31,9 @@ struct alignas(32) BBox8 {
   }
 };
 
-// Bit i set when box i is entered within [tnear, tmax]; entry[i] its entry distance.
-inline unsigned intersect8_scalar(const RayBoxPrecomputed& r, float tmax, const BBox8& b, float entry[8]) {
+// Bit i set when box i is entered within [tnear, tmax]; entry[i] its entry
+// distance (+inf for a missed box).
+inline unsigned intersect8_scalar(const Slab::Precomputed& r, float tmax, const BBox8& b, float entry[8]) {
   unsigned mask = 0;
   for (int lane = 0; lane < 8; ++lane) {
     BBox box;
@@ -40,14 +41,16 @@ inline unsigned intersect8_scalar(const RayBoxPrecomputed& r, float tmax, const 
       box.lower[a] = b.lower[a][lane];
       box.upper[a] = b.upper[a][lane];
     }
-    entry[lane] = enter_box(r, box, tmax);
-    if (entry[lane] != std::numeric_limits<float>::infinity()) mask |= 1u << lane;
+    BoxHit h;
+    const bool hit = Slab::intersect(r, box, tmax, h);
+    entry[lane] = hit ? h.t_entry : std::numeric_limits<float>::infinity();
+    mask |= static_cast<unsigned>(hit) << lane;
   }
   return mask;
 }
 
 #if defined(__AVX2__)
-inline unsigned intersect8_avx2(const RayBoxPrecomputed& r, float tmax, const BBox8& b, float entry[8]) {
+inline unsigned intersect8_avx2(const Slab::Precomputed& r, float tmax, const BBox8& b, float entry[8]) {
   __m256 t_entry = _mm256_set1_ps(r.tnear), t_exit = _mm256_set1_ps(tmax);
   for (int a = 0; a < 3; ++a) {
     const float* near_plane = r.negative[a] ? b.upper[a] : b.lower[a];
@@ -56,17 +59,20 @@ inline unsigned intersect8_avx2(const RayBoxPrecomputed& r, float tmax, const BB
     const __m256 t_near = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(near_plane), org), inv);
     const __m256 t_far = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(far_plane), org), inv);
     // max_ps/min_ps return their second operand when either is NaN: a NaN
-    // distance keeps the bound, exactly as enter_box's comparisons do.
+    // distance keeps the bound and a NaN bound stays NaN, exactly as
+    // Slab::clip's comparisons do.
     t_entry = _mm256_max_ps(t_near, t_entry);
     t_exit = _mm256_min_ps(t_far, t_exit);
   }
-  const __m256 hit = _mm256_cmp_ps(t_entry, t_exit, _CMP_LE_OQ);
+  // Slab::overlaps: entry <= exit, and an entry at +inf is never reached.
+  const __m256 hit = _mm256_and_ps(_mm256_cmp_ps(t_entry, t_exit, _CMP_LE_OQ),
+                                   _mm256_cmp_ps(t_entry, _mm256_set1_ps(std::numeric_limits<float>::infinity()), _CMP_LT_OQ));
   _mm256_store_ps(entry, _mm256_blendv_ps(_mm256_set1_ps(std::numeric_limits<float>::infinity()), t_entry, hit));
   return static_cast<unsigned>(_mm256_movemask_ps(hit));
 }
 #endif
 
-inline unsigned intersect8(const RayBoxPrecomputed& r, float tmax, const BBox8& b, float entry[8]) {
+inline unsigned intersect8(const Slab::Precomputed& r, float tmax, const BBox8& b, float entry[8]) {
 #if defined(__AVX2__)
   return intersect8_avx2(r, tmax, b, entry);
 #else
