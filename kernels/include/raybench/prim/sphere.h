@@ -1,7 +1,7 @@
 // The sphere as every ray-sphere test receives it, and what a test returns.
 #pragma once
 
-#include "raybench/math/vec.h"
+#include "raybench/math/ray.h"
 
 namespace raybench {
 
@@ -16,5 +16,16 @@ struct Sphere {
 struct SphereHit {
   float t_near, t_far;
 };
+
+// The shared last step of the fixed sphere tests: with roots t0 <= t1, a hit
+// when either lies in (tnear, tmax] (the far one when starting inside).
+// NaN roots reject.
+inline bool report_sphere_roots(const Ray& ray, float tmax, float t0, float t1, SphereHit& out) {
+  const bool in0 = t0 > ray.tnear && t0 <= tmax;
+  const bool in1 = t1 > ray.tnear && t1 <= tmax;
+  if (!(in0 || in1)) return false;
+  out = {t0, t1};
+  return true;
+}
 
 }  // namespace raybench

@@ -64,11 +64,7 @@ struct SpherePrecise {
       t1 = q / a;
       if (t0 > t1) std::swap(t0, t1);
     }
-    const bool in0 = t0 > ray.tnear && t0 <= tmax;
-    const bool in1 = t1 > ray.tnear && t1 <= tmax;
-    if (!(in0 || in1)) return false;
-    out = {t0, t1};
-    return true;
+    return report_sphere_roots(ray, tmax, t0, t1, out);
   }
 };
 

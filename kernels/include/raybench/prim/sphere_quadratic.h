@@ -44,11 +44,7 @@ struct SphereQuadratic {
     const float root = std::sqrt(discriminant);
     const float t0 = (-b - root) / (2.0f * a);  // root >= 0 and a > 0: t0 <= t1
     const float t1 = (-b + root) / (2.0f * a);
-    const bool in0 = t0 > ray.tnear && t0 <= tmax;
-    const bool in1 = t1 > ray.tnear && t1 <= tmax;
-    if (!(in0 || in1)) return false;
-    out = {t0, t1};
-    return true;
+    return report_sphere_roots(ray, tmax, t0, t1, out);
   }
 };
 
