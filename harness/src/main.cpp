@@ -185,6 +185,7 @@ int run(int argc, char** argv) {
     SuiteSettings& s = run_options.settings;
     s = run_options.suite.settings;
     if (!run_raysets.empty()) s.raysets = run_raysets;
+    run_options.raysets_from_command_line = !run_raysets.empty();
     if (!run_backends.empty()) s.backends = run_backends;
     if (!run_threads.empty()) s.threads = run_threads;
     if (run_rays) s.rays = run_rays;
@@ -208,7 +209,7 @@ int run(int argc, char** argv) {
     const SceneArg s = resolve_scene(rays_scene, suite);
     const RayGenerator generator(s.scene);
     RaySetSpec spec{kind, rays_count, rays_seed, s.entry ? s.entry->camera : std::nullopt,
-                    s.entry ? s.entry->light : std::nullopt};
+                    s.entry ? s.entry->light : std::nullopt, s.entry ? s.entry->inside : std::nullopt};
     const std::vector<Ray> rays = generator.generate(spec);
     write_ray_file(rays_out, rays);
     fmt::print("wrote {} {} rays for {} ({} triangles) to {}\n", rays.size(), rays_kind, s.scene.name,

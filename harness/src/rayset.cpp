@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <tbb/parallel_for.h>
 
 #include "error.h"
@@ -49,24 +50,39 @@ std::uint64_t stream_of(RaySetKind kind) { return hash_string(to_string(kind).c_
 
 }  // namespace
 
+constexpr RaySetKind kAllKinds[] = {RaySetKind::kPrimary,           RaySetKind::kDiffuse,         RaySetKind::kShadow,
+                                    RaySetKind::kUniform,           RaySetKind::kClosedInsideRandom, RaySetKind::kSharedEdgeAimed,
+                                    RaySetKind::kVertexAimed};
+
 std::string to_string(RaySetKind kind) {
   switch (kind) {
     case RaySetKind::kPrimary: return "primary";
     case RaySetKind::kDiffuse: return "diffuse";
     case RaySetKind::kShadow: return "shadow";
     case RaySetKind::kUniform: return "uniform";
+    case RaySetKind::kClosedInsideRandom: return "closed-inside-random";
+    case RaySetKind::kSharedEdgeAimed: return "shared-edge-aimed";
+    case RaySetKind::kVertexAimed: return "vertex-aimed";
   }
   return "?";
 }
 
+bool is_must_hit(RaySetKind kind) {
+  return kind == RaySetKind::kClosedInsideRandom || kind == RaySetKind::kSharedEdgeAimed || kind == RaySetKind::kVertexAimed;
+}
+
 std::string to_string(Query query) { return query == Query::kIntersect ? "intersect" : "occluded"; }
 
-std::vector<std::string> rayset_kind_names() { return {"primary", "diffuse", "shadow", "uniform"}; }
+std::vector<std::string> rayset_kind_names() {
+  std::vector<std::string> names;
+  for (RaySetKind k : kAllKinds) names.push_back(to_string(k));
+  return names;
+}
 
 RaySetKind parse_rayset_kind(const std::string& name) {
-  for (RaySetKind k : {RaySetKind::kPrimary, RaySetKind::kDiffuse, RaySetKind::kShadow, RaySetKind::kUniform})
+  for (RaySetKind k : kAllKinds)
     if (to_string(k) == name) return k;
-  throw InputError("", fmt::format("unknown ray set '{}' (known: primary, diffuse, shadow, uniform)", name));
+  throw InputError("", fmt::format("unknown ray set '{}' (known: {})", name, fmt::join(rayset_kind_names(), ", ")));
 }
 
 Query query_of(RaySetKind kind) { return kind == RaySetKind::kShadow ? Query::kOccluded : Query::kIntersect; }
@@ -110,8 +126,9 @@ std::uint64_t RayGenerator::key(const RaySetSpec& spec) const {
   const Camera c = spec.camera.value_or(default_camera());
   const Vec3f l = spec.light.value_or(default_light());
   std::uint64_t h = mix64(scene_.content_hash() ^ kRayGeneratorVersion);
+  const InsideBall b = spec.inside.value_or(InsideBall{});
   for (float f : {c.position.x, c.position.y, c.position.z, c.look_at.x, c.look_at.y, c.look_at.z, c.up.x, c.up.y,
-                  c.up.z, c.fov_degrees, c.aspect, l.x, l.y, l.z})
+                  c.up.z, c.fov_degrees, c.aspect, l.x, l.y, l.z, b.center.x, b.center.y, b.center.z, b.radius})
     h = mix64(h ^ std::bit_cast<std::uint32_t>(f));
   return mix64(h ^ mix64(stream_of(spec.kind) ^ mix64(spec.count ^ mix64(spec.seed))));
 }
@@ -123,6 +140,9 @@ std::vector<Ray> RayGenerator::generate(const RaySetSpec& spec) const {
     case RaySetKind::kDiffuse:
     case RaySetKind::kShadow: return from_primary_hits(spec, camera);
     case RaySetKind::kUniform: return uniform(spec);
+    case RaySetKind::kClosedInsideRandom:
+    case RaySetKind::kSharedEdgeAimed:
+    case RaySetKind::kVertexAimed: return must_hit(spec);
   }
   return {};
 }
@@ -214,6 +234,46 @@ std::vector<Ray> RayGenerator::uniform(const RaySetSpec& spec) const {
     Ray r;
     r.org = to_vec(origin);
     r.dir = to_vec((target - origin).normalized());
+    rays[i] = r;
+  });
+  return rays;
+}
+
+// G01-G03 of ../shared/EXTREMES.md: origins uniform in the declared inside
+// ball; G01 uniform directions, G02 aimed at float lerp(a, b, s) on a random
+// edge of a random triangle, G03 at a random vertex. On a closed mesh every
+// one of these rays must hit.
+std::vector<Ray> RayGenerator::must_hit(const RaySetSpec& spec) const {
+  if (!spec.inside || !(spec.inside->radius > 0.0f))
+    throw InputError(scene_.name, fmt::format("ray set '{}' needs a closed mesh with a ball inside it: declare "
+                                              "inside = {{ center = [x, y, z], radius = r }} for the scene in the suite manifest",
+                                              to_string(spec.kind)));
+  std::vector<Ray> rays(spec.count);
+  const std::size_t triangles = scene_.triangles.size();
+  tbb::parallel_for(std::size_t{0}, spec.count, [&](std::size_t i) {
+    Rng rng(spec.seed, stream_of(spec.kind), i);
+    // Uniform in the ball: a uniform direction times radius * cbrt(u).
+    const double z = 2.0 * rng.next_double() - 1.0, phi = 2.0 * std::numbers::pi * rng.next_double();
+    const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const Eigen::Vector3d unit(s * std::cos(phi), z, s * std::sin(phi));
+    const Eigen::Vector3d origin = to_eigen(spec.inside->center) + unit * (spec.inside->radius * std::cbrt(rng.next_double()));
+    Ray r;
+    r.org = to_vec(origin);
+    if (spec.kind == RaySetKind::kClosedInsideRandom) {
+      const double z2 = 2.0 * rng.next_double() - 1.0, phi2 = 2.0 * std::numbers::pi * rng.next_double();
+      const double s2 = std::sqrt(std::max(0.0, 1.0 - z2 * z2));
+      r.dir = to_vec(Eigen::Vector3d(s2 * std::cos(phi2), z2, s2 * std::sin(phi2)));
+    } else {
+      const Triangle& t = scene_.triangles[rng.next_u64() % triangles];
+      const Vec3f corners[3] = {t.v0, t.v1, t.v2};
+      const auto corner = rng.next_u64() % 3;
+      Vec3f target = corners[corner];
+      if (spec.kind == RaySetKind::kSharedEdgeAimed) {
+        const float along = static_cast<float>(rng.next_double());
+        target = corners[corner] + (corners[(corner + 1) % 3] - corners[corner]) * along;  // the float lerp
+      }
+      r.dir = target - r.org;  // unnormalised on purpose: d = target - o, as G02/G03 define it
+    }
     rays[i] = r;
   });
   return rays;

@@ -14,7 +14,17 @@
 
 namespace raybench {
 
-enum class RaySetKind { kPrimary, kDiffuse, kShadow, kUniform };
+enum class RaySetKind {
+  kPrimary,
+  kDiffuse,
+  kShadow,
+  kUniform,
+  // Must-hit ray sets of ../shared/EXTREMES.md, for closed meshes that
+  // declare a ball inside them: every ray must hit, a miss is a leak.
+  kClosedInsideRandom,  // G01: origins in the ball, uniform directions
+  kSharedEdgeAimed,     // G02: origins in the ball, aimed at a float point of a random edge
+  kVertexAimed,         // G03: origins in the ball, aimed at a random vertex
+};
 
 // Which query a ray set is traced with.
 enum class Query { kIntersect, kOccluded };
@@ -25,6 +35,8 @@ std::string to_string(Query query);
 RaySetKind parse_rayset_kind(const std::string& name);
 std::vector<std::string> rayset_kind_names();
 Query query_of(RaySetKind kind);
+// True for the must-hit kinds (G01-G03): they need RaySetSpec::inside.
+bool is_must_hit(RaySetKind kind);
 
 // A pinhole camera; y is up unless `up` says otherwise.
 struct Camera {
@@ -33,17 +45,24 @@ struct Camera {
   float aspect = 4.0f / 3.0f;
 };
 
+// A ball strictly inside a closed mesh: origins of the must-hit ray sets.
+struct InsideBall {
+  Vec3f center;
+  float radius = 0.0f;
+};
+
 struct RaySetSpec {
   RaySetKind kind = RaySetKind::kPrimary;
   std::size_t count = 0;
   std::uint64_t seed = 1;
   std::optional<Camera> camera;  // default: frames the scene's bounds from outside
   std::optional<Vec3f> light;    // shadow rays' point light; default: above the scene
+  std::optional<InsideBall> inside{};  // required by the must-hit kinds
 };
 
 // Bumped whenever generation changes, so stored ray sets are never reused
 // across generator versions.
-inline constexpr int kRayGeneratorVersion = 2;
+inline constexpr int kRayGeneratorVersion = 3;
 
 // Makes ray sets for one scene. Diffuse and shadow rays start at primary
 // hits, found with our BVH2 (built once here).
@@ -64,6 +83,7 @@ class RayGenerator {
   std::vector<Ray> primary(const RaySetSpec& spec, const Camera& camera) const;
   std::vector<Ray> from_primary_hits(const RaySetSpec& spec, const Camera& camera) const;
   std::vector<Ray> uniform(const RaySetSpec& spec) const;
+  std::vector<Ray> must_hit(const RaySetSpec& spec) const;
 
   const Scene& scene_;
   BBox bounds_;

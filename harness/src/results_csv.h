@@ -3,6 +3,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,8 @@ struct ResultRow {
   std::size_t prim_ties = 0;
   double t_relerr_max = 0, t_relerr_p999 = 0;  // NaN for occlusion queries
   std::size_t disagreements = 0;
+  // Must-hit ray sets only (G01-G03): rays this backend reports as misses.
+  std::optional<std::size_t> leaks;
 };
 
 // Column names in file order.

@@ -160,7 +160,7 @@ Suite load_suite(const std::string& path) {
       const std::string key = fmt::format("scene[{}]", index++);
       const toml::table* t = e.as_table();
       if (!t) r.fail(key, "expected a table");
-      r.check_keys(*t, key, {"name", "path", "optional", "camera", "light", "note"});
+      r.check_keys(*t, key, {"name", "path", "optional", "camera", "light", "inside", "raysets", "note"});
       SuiteScene scene;
       scene.name = r.get<std::string>(*t, key + ".", "name", "");
       scene.path = r.get<std::string>(*t, key + ".", "path", "");
@@ -171,6 +171,22 @@ Suite load_suite(const std::string& path) {
       scene.optional = r.get<bool>(*t, key + ".", "optional", false);
       if (const toml::node* c = t->get("camera")) scene.camera = r.camera(*c, key + ".camera");
       if (const toml::node* l = t->get("light")) scene.light = r.vec3(*l, key + ".light");
+      if (const toml::node* in = t->get("inside")) {
+        const toml::table* b = in->as_table();
+        if (!b || !b->get("center")) r.fail(key + ".inside", "expected { center = [x, y, z], radius = r }");
+        r.check_keys(*b, key + ".inside", {"center", "radius"});
+        scene.inside = InsideBall{r.vec3(*b->get("center"), key + ".inside.center"),
+                                  r.get<float>(*b, key + ".inside.", "radius", 0.0f)};
+        if (!(scene.inside->radius > 0.0f)) r.fail(key + ".inside.radius", "must be > 0");
+      }
+      scene.raysets = r.strings(*t, key + ".", "raysets", {});
+      for (const std::string& k : scene.raysets) {
+        try {
+          parse_rayset_kind(k);
+        } catch (const InputError& e) {
+          r.fail(key + ".raysets", e.what());
+        }
+      }
       suite.scenes.push_back(std::move(scene));
     }
   }

@@ -17,6 +17,8 @@ struct SuiteScene {
   bool optional = false;  // skipped with a note when the file is absent
   std::optional<Camera> camera;
   std::optional<Vec3f> light;
+  std::optional<InsideBall> inside;  // a closed mesh's inner ball: enables the must-hit ray sets
+  std::vector<std::string> raysets;  // this scene's ray sets; empty: the suite's defaults
 
   bool available() const;
 };

@@ -76,8 +76,7 @@ LoadedScene load(const RunOptions& options, const std::string& name_or_path) {
 std::vector<ResultRow> run_suite(const RunOptions& options) {
   const SuiteSettings& settings = options.settings;
   // Validate everything cheap before spending minutes.
-  std::vector<RaySetKind> kinds;
-  for (const std::string& k : settings.raysets) kinds.push_back(parse_rayset_kind(k));
+  for (const std::string& k : settings.raysets) parse_rayset_kind(k);
   for (const std::string& b : settings.backends) make_backend(b);
   if (settings.rays == 0) throw InputError("", "--rays must be at least 1");
   if (settings.repetitions < 1) throw InputError("", "--reps must be at least 1");
@@ -111,11 +110,23 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
     std::vector<RaySet> raysets;
     {
       const RayGenerator generator(scene);
-      for (RaySetKind kind : kinds) {
+      const std::vector<std::string>& names =
+          options.raysets_from_command_line || !entry || entry->raysets.empty() ? settings.raysets : entry->raysets;
+      for (const std::string& name : names) {
+        const RaySetKind kind = parse_rayset_kind(name);
+        const std::optional<InsideBall> inside = entry ? entry->inside : std::nullopt;
+        if (is_must_hit(kind) && !inside) {
+          progress(fmt::format("  {}: skipped, the scene declares no inside ball (closed meshes only)", name));
+          continue;
+        }
         RaySetSpec spec{kind, settings.rays, settings.seed, entry ? entry->camera : std::nullopt,
-                        entry ? entry->light : std::nullopt};
+                        entry ? entry->light : std::nullopt, inside};
         raysets.push_back({kind, obtain_rays(generator, scene, spec, options.rays_dir)});
       }
+    }
+    if (raysets.empty()) {
+      progress(fmt::format("[{}/{}] {}: no ray set applies, scene skipped", si + 1, scenes.size(), scene.name));
+      continue;
     }
 
     struct Case {
@@ -188,6 +199,7 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
           row.t_relerr_max = a.has_prims ? a.t_relerr_max : std::nan("");
           row.t_relerr_p999 = a.has_prims ? a.t_relerr_p999 : std::nan("");
           row.disagreements = a.disagreements();
+          if (is_must_hit(rs.kind)) row.leaks = a.rays - a.hits;
           const std::string name =
               fmt::format("trace/{}/{}/{}/threads:{}", scene.name, row.rayset, backend_name, threads);
           cases.push_back({name, row, backend.get(), &executor, &rs});
@@ -276,21 +288,28 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
 }
 
 std::string format_results_table(const std::vector<ResultRow>& rows) {
-  std::string out;
-  std::string scene;
+  // Column widths follow the longest ray-set and backend names in the run.
+  std::size_t rayset_width = 6, backend_width = 7;
+  for (const ResultRow& r : rows) {
+    rayset_width = std::max(rayset_width, r.rayset.size());
+    backend_width = std::max(backend_width, r.backend.size());
+  }
   const auto percent = [](double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.3f}%", 100.0 * v); };
+  std::string out, scene;
   for (const ResultRow& r : rows) {
     if (r.scene != scene) {
       scene = r.scene;
       out += fmt::format("\n{} ({} triangles)\n", r.scene, r.triangles);
-      out += fmt::format("  {:<8} {:<18} {:>3} {:>9} {:>19} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9}\n", "rayset", "backend",
-                         "thr", "Mrays/s", "[min - max]", "x embree", "hit", "agree", "same tri", "build ms", "MiB");
+      out += fmt::format("  {:<{}} {:<{}} {:>3} {:>9} {:>19} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>7}\n", "rayset",
+                         rayset_width, "backend", backend_width, "thr", "Mrays/s", "[min - max]", "x embree", "hit", "agree",
+                         "same tri", "build ms", "MiB", "leaks");
     }
-    out += fmt::format("  {:<8} {:<18} {:>3} {:>9.2f} {:>19} {:>8} {:>8} {:>9} {:>9} {:>9.1f} {:>9.1f}\n", r.rayset,
-                       r.backend, r.threads, r.mrays_s, fmt::format("[{:.2f} - {:.2f}]", r.mrays_s_min, r.mrays_s_max),
+    out += fmt::format("  {:<{}} {:<{}} {:>3} {:>9.2f} {:>19} {:>8} {:>8} {:>9} {:>9} {:>9.1f} {:>9.1f} {:>7}\n", r.rayset,
+                       rayset_width, r.backend, backend_width, r.threads, r.mrays_s,
+                       fmt::format("[{:.2f} - {:.2f}]", r.mrays_s_min, r.mrays_s_max),
                        r.ratio_to_embree > 0 ? fmt::format("{:.2f}", r.ratio_to_embree) : "-",
-                       fmt::format("{:.1f}%", 100.0 * r.hit_rate), percent(r.agree_hit), percent(r.agree_prim),
-                       r.build_ms, r.memory_bytes / 1048576.0);
+                       fmt::format("{:.1f}%", 100.0 * r.hit_rate), percent(r.agree_hit), percent(r.agree_prim), r.build_ms,
+                       r.memory_bytes / 1048576.0, r.leaks ? std::to_string(*r.leaks) : "-");
   }
   return out;
 }

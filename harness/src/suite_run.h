@@ -17,6 +17,7 @@ struct RunOptions {
   std::vector<std::string> scenes;   // suite scene names or mesh paths; empty: every available suite scene
   std::string out_csv;
   std::string rays_dir;              // where ray sets are stored and reused
+  bool raysets_from_command_line = false;  // settings.raysets then override each scene's own list
   bool interleave = true;            // interleave repetitions of all cases of a scene
   std::string command_line;          // recorded in the metadata
 };

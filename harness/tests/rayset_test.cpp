@@ -110,6 +110,29 @@ TEST(RaySets, ACameraThatSeesNothingIsAnErrorNotAnEndlessLoop) {
   EXPECT_THROW(RayGenerator(test_scene()).generate({RaySetKind::kDiffuse, 100, 1, away, std::nullopt}), InputError);
 }
 
+TEST(MustHitRaySets, StartInsideTheDeclaredBallAndAimAtTheMesh) {
+  const Scene sphere = load_scene("proc:sphere");
+  const InsideBall ball{{0, 0, 0}, 0.5f};
+  const RayGenerator gen(sphere);
+  for (RaySetKind kind : {RaySetKind::kClosedInsideRandom, RaySetKind::kSharedEdgeAimed, RaySetKind::kVertexAimed}) {
+    EXPECT_TRUE(is_must_hit(kind));
+    const std::vector<Ray> rays = gen.generate({kind, 2000, 1, std::nullopt, std::nullopt, ball});
+    ASSERT_EQ(rays.size(), 2000u);
+    for (const Ray& r : rays) {
+      EXPECT_LE(length(r.org), 0.5f * (1 + 1e-6f));
+      if (kind == RaySetKind::kClosedInsideRandom) continue;
+      // Aimed at the mesh: org + dir lands on the unit sphere's surface (a vertex or an edge point).
+      EXPECT_NEAR(length(r.org + r.dir), 1.0f, 0.02f);
+    }
+  }
+  EXPECT_FALSE(is_must_hit(RaySetKind::kUniform));
+}
+
+TEST(MustHitRaySets, NeedADeclaredBall) {
+  EXPECT_THROW(RayGenerator(load_scene("proc:sphere")).generate({RaySetKind::kVertexAimed, 10, 1, std::nullopt, std::nullopt}),
+               InputError);
+}
+
 TEST(RaySets, KindNamesRoundTripAndUnknownNamesAreErrors) {
   for (const std::string& name : rayset_kind_names()) EXPECT_EQ(to_string(parse_rayset_kind(name)), name);
   EXPECT_THROW(parse_rayset_kind("specular"), InputError);

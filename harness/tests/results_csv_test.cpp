@@ -46,9 +46,14 @@ TEST(ResultsCsv, RowsRoundTripAndNotApplicableIsEmpty) {
   row.agree_prim = std::nan("");
   row.t_relerr_max = std::nan("");
   row.disagreements = 4;
-  write_results_csv(dir.file("r.csv"), {row});
+  ResultRow must_hit = row;
+  must_hit.rayset = "vertex-aimed";
+  must_hit.leaks = 0;
+  write_results_csv(dir.file("r.csv"), {row, must_hit});
   const auto rows = read_results_csv(dir.file("r.csv"));
-  ASSERT_EQ(rows.size(), 1u);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].at("leaks"), "");  // not a must-hit ray set
+  EXPECT_EQ(rows[1].at("leaks"), "0");
   EXPECT_EQ(rows[0].at("scene"), "bunny, scanned");
   EXPECT_EQ(rows[0].at("backend"), "embree:high");
   EXPECT_EQ(rows[0].at("threads"), "2");

@@ -46,6 +46,20 @@ TEST(Suite, CamerasAndLightsAreRead) {
   EXPECT_EQ(s.scenes[0].light->y, 2.0f);
 }
 
+TEST(Suite, AClosedSceneDeclaresItsInsideBallAndItsOwnRaySets) {
+  TempDir dir;
+  const auto path = dir.write("s.toml",
+                              "[[scene]]\nname = \"ball\"\npath = \"proc:sphere\"\n"
+                              "inside = { center = [0, 0, 0], radius = 0.5 }\nraysets = [\"vertex-aimed\"]\n");
+  const Suite s = load_suite(path);
+  ASSERT_TRUE(s.scenes[0].inside);
+  EXPECT_EQ(s.scenes[0].inside->radius, 0.5f);
+  EXPECT_EQ(s.scenes[0].raysets, (std::vector<std::string>{"vertex-aimed"}));
+  const Suite defaults = load_suite(std::string(RAYBENCH_SOURCE_DIR) + "/meshes/default.toml");
+  ASSERT_NE(defaults.find("sphere"), nullptr);
+  EXPECT_TRUE(defaults.find("sphere")->inside.has_value());
+}
+
 TEST(Suite, MistakesNameTheFileAndTheKey) {
   TempDir dir;
   const struct {
@@ -59,6 +73,9 @@ TEST(Suite, MistakesNameTheFileAndTheKey) {
       {"[[scene]]\nname = \"a\"\npath = \"p\"\ncamera = { position = [0, 0] , look_at = [0,0,0] }\n", "camera.position"},
       {"[[scene]]\nname = \"a\"\n", "needs a name and a path"},
       {"[defaults\n", "line 1"},
+      {"[[scene]]\nname = \"a\"\npath = \"p\"\ninside = { center = [0, 0, 0], radius = 0 }\n", "inside.radius"},
+      {"[[scene]]\nname = \"a\"\npath = \"p\"\ninside = { radius = 1 }\n", "scene[0].inside"},
+      {"[[scene]]\nname = \"a\"\npath = \"p\"\nraysets = [\"edge\"]\n", "scene[0].raysets"},
       {"[defaults]\n", "no [[scene]]"},
   };
   int i = 0;
