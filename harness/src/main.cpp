@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <iostream>
 #include <sstream>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -10,7 +11,9 @@
 #include "agreement.h"
 #include "build_info.h"
 #include "backend.h"
+#include "compare.h"
 #include "error.h"
+#include "atomic_file.h"
 #include "kernel_bench.h"
 #include "metadata.h"
 #include "npy.h"
@@ -145,6 +148,41 @@ int run(int argc, char** argv) {
   kernels_cmd->add_option("--min-time", kernel_options.min_time, "Minimum seconds per repetition")->capture_default_str()->check(CLI::PositiveNumber);
   kernels_cmd->add_option("--pairs", kernel_options.pairs, "Ray-primitive pairs per family and input")->capture_default_str();
 
+  // raybench compare
+  std::string compare_base, compare_current, compare_format = "table", compare_out;
+  bool compare_force = false;
+  CompareOptions compare_options;
+  CLI::App* compare_cmd = app.add_subcommand(
+      "compare", "Compare two results CSVs row by row: throughput and ratio to Embree with a noise-aware verdict, "
+                 "deterministic columns exactly");
+  compare_cmd->add_option("base", compare_base, "Baseline results CSV")->required();
+  compare_cmd->add_option("current", compare_current, "Results CSV to compare with it")->required();
+  compare_cmd->add_option("--format,-f", compare_format, "table, md or json")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"table", "md", "json"}));
+  compare_cmd->add_option("--out,-o", compare_out, "Write to this file instead of stdout");
+  compare_cmd->add_flag("--force", compare_force, "Compare even when the machine metadata differ");
+  compare_cmd->add_option("--alpha", compare_options.alpha, "Significance level of the Mann-Whitney U test")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  compare_cmd->add_option("--min-effect", compare_options.min_effect, "Smallest relative change that gets a verdict")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
+
+  // raybench gate
+  std::string gate_baseline, gate_config = std::string(RAYBENCH_SOURCE_DIR) + "/results/gate.toml";
+  std::vector<std::string> gate_currents;
+  bool gate_verbose = false;
+  CLI::App* gate_cmd = app.add_subcommand(
+      "gate", "Fail (exit 1) when the current results regress against a baseline beyond the thresholds of a gate config");
+  gate_cmd->add_option("--baseline", gate_baseline, "Baseline results CSV")->required();
+  gate_cmd->add_option("--current", gate_currents,
+                       "Current results CSV; give it twice (two independent runs) to count a throughput "
+                       "regression only when both show it")
+      ->required();
+  gate_cmd->add_option("--config", gate_config, "Thresholds (TOML)")->capture_default_str();
+  gate_cmd->add_flag("--verbose,-v", gate_verbose, "Also print the full comparison table");
+
   // raybench backends / scenes
   CLI::App* backends_cmd = app.add_subcommand("backends", "List backend names");
   std::string scenes_suite = kDefaultSuite;
@@ -159,6 +197,48 @@ int run(int argc, char** argv) {
     return 2;
   }
 
+  if (*compare_cmd) {
+    const ResultsFile base = read_results_file(compare_base);
+    const ResultsFile current = read_results_file(compare_current);
+    if (const auto diffs = machine_differences(base, current); !diffs.empty() && !compare_force) {
+      std::string all;
+      for (const auto& d : diffs) all += (all.empty() ? "" : "; ") + d;
+      throw InputError(compare_current, "not comparable with " + compare_base + ": " + all +
+                                            " (ratios to Embree still are: use --force to compare anyway)");
+    }
+    const Comparison c = compare_results(base, current, compare_options);
+    const OutputFormat format = compare_format == "md" ? OutputFormat::kMarkdown
+                                : compare_format == "json" ? OutputFormat::kJson
+                                                           : OutputFormat::kTable;
+    const bool colour = compare_out.empty() && format == OutputFormat::kTable && ::isatty(1);
+    const std::string text = format_comparison(c, base, current, format, colour);
+    if (compare_out.empty()) std::cout << text;
+    else write_file_atomically(compare_out, [&](std::ostream& o) { o << text; });
+    return 0;
+  }
+  if (*gate_cmd) {
+    const GateConfig config = load_gate_config(gate_config);
+    const ResultsFile baseline = read_results_file(gate_baseline);
+    std::vector<ResultsFile> currents;
+    for (const std::string& path : gate_currents) {
+      currents.push_back(read_results_file(path));
+      if (currents.back().rows.empty()) throw InputError(path, "has no result rows");
+    }
+    const ResultsFile& current = currents.front();
+    const GateResult g = run_gate(baseline, currents, config);
+    if (gate_verbose) {
+      CompareOptions o;
+      o.alpha = config.alpha;
+      o.min_effect = config.max_ratio_drop;
+      std::cout << format_comparison(compare_results(baseline, current, o), baseline, current, OutputFormat::kTable,
+                                     ::isatty(1)) << "\n";
+    }
+    for (const auto& n : g.notes) std::cout << "note: " << n << "\n";
+    for (const auto& f : g.failures) std::cout << "FAIL: " << f << "\n";
+    std::cout << fmt::format("gate: {} ({} rows compared against {}, {} failure{})\n", g.failures.empty() ? "PASS" : "FAIL",
+                             current.rows.size(), gate_baseline, g.failures.size(), g.failures.size() == 1 ? "" : "s");
+    return g.failures.empty() ? 0 : 1;
+  }
   if (*kernels_cmd) {
     kernel_options.command_line = command_line(argc, argv);
     const std::vector<KernelResult> results = run_kernel_benchmarks(kernel_options);

@@ -235,6 +235,165 @@ class SuiteRun(CliTestCase):
                 self.assertFalse(os.path.exists(out))
 
 
+def read_csv(path):
+    with open(path) as f:
+        reader = csv.DictReader(f)
+        return reader.fieldnames, list(reader)
+
+
+def write_csv(path, fields, rows):
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=fields, lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+class CompareAndGate(CliTestCase):
+    """A real small run is the baseline; copies of it are doctored the way a regression would look."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.shared = tempfile.TemporaryDirectory()
+        suite = os.path.join(cls.shared.name, "suite.toml")
+        with open(suite, "w") as f:
+            f.write('[defaults]\nrays = 4000\nrepetitions = 7\nbuild_repetitions = 1\nmin_time = 0.01\nwarmup = 0.0\n'
+                    'raysets = ["primary", "diffuse"]\nbackends = ["embree", "bvh2", "bvh2:watertight:robust"]\n'
+                    f'[[scene]]\nname = "terrain"\npath = "{SCENE}"\n'
+                    '[[scene]]\nname = "sphere"\npath = "proc:sphere"\n'
+                    'inside = { center = [0, 0, 0], radius = 0.9 }\nraysets = ["vertex-aimed"]\n')
+        cls.baseline = os.path.join(cls.shared.name, "base.csv")
+        result = run("run", "--suite", suite, "--out", cls.baseline, "--rays-dir", os.path.join(cls.shared.name, "rays"))
+        assert result.returncode == 0, result.stderr
+        # The measured samples carry this machine's noise (wide under a parallel
+        # ctest). The gate's behaviour on a given shift must not depend on it:
+        # give every row 7 fixed samples spread +-0.8 % around its median.
+        fields, rows = read_csv(cls.baseline)
+        for row in rows:
+            m = float(row["mrays_s"])
+            row["mrays_s_samples"] = ";".join(f"{m * (1 + 0.0027 * k):.6g}" for k in range(-3, 4))
+        write_csv(cls.baseline, fields, rows)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.shared.cleanup()
+
+    def doctored(self, name, change):
+        """A copy of the baseline (CSV and metadata) with change(row) applied to every row."""
+        fields, rows = read_csv(self.baseline)
+        for row in rows:
+            change(row)
+        path = self.path(name + ".csv")
+        write_csv(path, fields, rows)
+        with open(self.baseline.replace(".csv", ".meta.toml")) as src, open(path.replace(".csv", ".meta.toml"), "w") as dst:
+            dst.write(src.read())
+        return path
+
+    def gate(self, current):
+        return run("gate", "--baseline", self.baseline, "--current", current)
+
+    def test_identical_results_pass(self):
+        result = self.gate(self.doctored("same", lambda row: None))
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        self.assertIn("gate: PASS", result.stdout)
+
+    def test_a_20_percent_drop_of_the_ratio_to_embree_fails(self):
+        def slower(row):
+            if row["backend"] == "bvh2" and row["rayset"] == "primary":
+                samples = [float(v) * 0.8 for v in row["mrays_s_samples"].split(";")]
+                row["mrays_s_samples"] = ";".join(f"{v:.6g}" for v in samples)
+        result = self.gate(self.doctored("slower", slower))
+        self.assertEqual(result.returncode, 1, result.stdout + result.stderr)
+        self.assertIn("FAIL: terrain/primary/bvh2/threads:1: ratio to Embree fell 20.0%", result.stdout)
+
+    def test_a_drop_counts_only_when_the_confirming_run_shows_it_too(self):
+        def slower(row):
+            if row["backend"] == "bvh2" and row["rayset"] == "primary":
+                row["mrays_s_samples"] = ";".join(f"{float(v) * 0.8:.6g}" for v in row["mrays_s_samples"].split(";"))
+        drop, same = self.doctored("drop", slower), self.doctored("same2", lambda row: None)
+        fluke = run("gate", "--baseline", self.baseline, "--current", drop, "--current", same)
+        self.assertEqual(fluke.returncode, 0, fluke.stdout)
+        self.assertIn("in one run but not in the confirming run", fluke.stdout)
+        real = run("gate", "--baseline", self.baseline, "--current", drop, "--current", self.doctored("drop2", slower))
+        self.assertEqual(real.returncode, 1, real.stdout)
+        self.assertIn("confirmed by another run", real.stdout)
+
+    def test_a_slow_machine_does_not_fail_when_ratios_hold(self):
+        def everything_slower(row):
+            row["mrays_s_samples"] = ";".join(f"{float(v) * 0.6:.6g}" for v in row["mrays_s_samples"].split(";"))
+        result = self.gate(self.doctored("slow_machine", everything_slower))
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+
+    def test_lowered_agreement_fails(self):
+        def worse(row):
+            if row["backend"] == "bvh2" and row["rayset"] == "diffuse":
+                row["agree_hit"] = f"{float(row['agree_hit']) - 0.001:.6g}"
+        result = self.gate(self.doctored("worse", worse))
+        self.assertEqual(result.returncode, 1, result.stdout + result.stderr)
+        self.assertIn("terrain/diffuse/bvh2/threads:1: agree_hit fell", result.stdout)
+
+    def test_a_new_leak_of_a_watertight_backend_fails(self):
+        def leaky(row):
+            if row["backend"] == "bvh2:watertight:robust" and row["rayset"] == "vertex-aimed":
+                self.assertEqual(row["leaks"], "0")
+                row["leaks"] = "3"
+        result = self.gate(self.doctored("leaky", leaky))
+        self.assertEqual(result.returncode, 1, result.stdout + result.stderr)
+        self.assertIn("sphere/vertex-aimed/bvh2:watertight:robust/threads:1: new leaks: 3", result.stdout)
+
+    def test_a_missing_row_fails(self):
+        fields, rows = read_csv(self.baseline)
+        path = self.path("missing.csv")
+        write_csv(path, fields, [r for r in rows if r["backend"] != "bvh2"])
+        result = self.gate(path)
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("in the baseline but not in the current run", result.stdout)
+
+    def test_unreadable_input_exits_2_never_0(self):
+        self.assertBadInput(self.gate(self.path("absent.csv")), "absent.csv")
+        broken = self.path("broken.csv")
+        with open(broken, "w") as f:
+            f.write("scene,backend\nx,y\n")
+        self.assertBadInput(self.gate(broken), broken, "missing column")
+        config = self.path("gate.toml")
+        with open(config, "w") as f:
+            f.write("max_ratio_dorp = 0.1\n")
+        result = run("gate", "--baseline", self.baseline, "--current", self.baseline, "--config", config)
+        self.assertBadInput(result, config, "unknown key")
+        def garbled(row):
+            row["agree_hit"] = "lots"
+        garbled_path = self.doctored("garbled", garbled)
+        self.assertBadInput(self.gate(garbled_path), garbled_path, "'agree_hit'", "not a number")
+
+    def test_compare_reports_verdicts_in_every_format(self):
+        def slower(row):
+            if row["backend"] == "bvh2":
+                row["mrays_s_samples"] = ";".join(f"{float(v) * 0.5:.6g}" for v in row["mrays_s_samples"].split(";"))
+        current = self.doctored("half", slower)
+        table = run("compare", self.baseline, current)
+        self.assertEqual(table.returncode, 0, table.stderr)
+        self.assertIn("slower", table.stdout)
+        md = run("compare", self.baseline, current, "--format", "md")
+        self.assertTrue(md.stdout.startswith("| scene |"), md.stdout[:200])
+        js = json.loads(run("compare", self.baseline, current, "--format", "json").stdout)
+        verdicts = {(r["scene"], r["rayset"], r["backend"]): r["mrays_s"]["verdict"] for r in js["rows"]}
+        self.assertEqual(verdicts[("terrain", "primary", "bvh2")], "slower")
+        self.assertEqual(verdicts[("terrain", "primary", "embree")], "same")
+
+    def test_compare_refuses_another_machine_unless_forced(self):
+        other = self.doctored("other", lambda row: None)
+        meta = other.replace(".csv", ".meta.toml")
+        with open(meta) as f:
+            text = f.read()
+        with open(meta, "w") as f:
+            f.write(text.replace('cpu = "', 'cpu = "Another CPU, '))
+        self.assertBadInput(run("compare", self.baseline, other), "cpu", "--force")
+        self.assertEqual(run("compare", self.baseline, other, "--force").returncode, 0)
+        # The gate still runs: it gates on ratios, which survive a change of machine.
+        result = self.gate(other)
+        self.assertEqual(result.returncode, 0, result.stdout)
+        self.assertIn("note: machine differs", result.stdout)
+
+
 class KernelMicrobenchmarks(CliTestCase):
     def test_every_variant_is_timed_and_written_as_csv_and_json(self):
         out, js = self.path("k.csv"), self.path("k.json")
