@@ -20,6 +20,7 @@ const std::vector<Family>& families() {
   static const std::vector<Family> list = {
       {"embree", make_embree_backend, embree_backend_names},
       {"bvh2", make_bvh2_backend, bvh2_backend_names},
+      {"bvh8", make_bvh8_backend, bvh8_backend_names},
   };
   return list;
 }

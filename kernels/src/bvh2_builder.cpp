@@ -51,7 +51,7 @@ class Builder {
     if (count <= 1) return make_leaf();
 
     const Split split = depth < options_.max_sah_depth ? find_split(begin, end, centroid_bounds) : Split{};
-    const float leaf_cost = static_cast<float>(count);
+    const float leaf_cost = tests(count);
     std::size_t middle;
     if (split.axis < 0) {
       // All centroids coincide (e.g. duplicated or degenerate triangles), or the
@@ -85,6 +85,12 @@ class Builder {
   std::uint32_t node_count() const { return next_node_.load(); }
 
  private:
+  // Leaf tests for n triangles, in units of one triangle test.
+  float tests(std::size_t n) const {
+    const auto g = static_cast<std::size_t>(std::max(1, options_.leaf_granularity));
+    return static_cast<float>((n + g - 1) / g);
+  }
+
   int bin_of(float c, float lo, float scale) const {
     const int b = static_cast<int>((c - lo) * scale);
     return std::clamp(b, 0, bins_ - 1);
@@ -112,14 +118,14 @@ class Builder {
       for (int b = bins - 1; b > 0; --b) {
         acc.extend(bin_bounds[b]);
         n += bin_count[b];
-        right_cost[b] = acc.half_area() * static_cast<float>(n);
+        right_cost[b] = acc.half_area() * tests(n);
       }
       acc = BBox{};
       n = 0;
       for (int b = 0; b < bins - 1; ++b) {
         acc.extend(bin_bounds[b]);
         n += bin_count[b];
-        const float cost = acc.half_area() * static_cast<float>(n) + right_cost[b + 1];
+        const float cost = acc.half_area() * tests(n) + right_cost[b + 1];
         if (n > 0 && n < end - begin && cost < best.cost) best = {axis, b, cost};
       }
     }

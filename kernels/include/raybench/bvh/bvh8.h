@@ -1,0 +1,42 @@
+// An 8-wide BVH collapsed from a Bvh2: each node holds its 8 children's
+// bounds structure-of-arrays (BBox8), so one AVX2 slab test visits all of
+// them; leaves are Triangle8 packs of up to 8 triangles, tested at once.
+// The collapse is the usual greedy one (Wald et al., "Getting Rid of Packets",
+// RT 2008; Embree's BVH8 from BVH2): open the child with the largest surface
+// area until 8 children or only leaves remain.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "raybench/bvh/bvh2.h"
+#include "raybench/simd/box8.h"
+#include "raybench/simd/triangle8.h"
+
+namespace raybench {
+
+struct alignas(32) Bvh8Node {
+  BBox8 bounds;             // empty boxes in unused lanes: no ray enters them
+  std::uint32_t child[8];   // kEmptyChild, an inner node index, or kLeafBit | pack index
+};
+
+struct Bvh8 {
+  static constexpr std::uint32_t kLeafBit = 0x80000000u;
+  static constexpr std::uint32_t kEmptyChild = 0xffffffffu;
+
+  std::vector<Bvh8Node> nodes;          // nodes[0] is the root
+  std::vector<Triangle8> packs;         // leaves: up to 8 triangles each
+  std::vector<std::int32_t> pack_prims;  // 8 per pack: input triangle index, -1 in unused lanes
+  std::size_t depth = 0;                 // levels below the root; bounds the traversal stack
+
+  std::size_t memory_bytes() const {
+    return nodes.size() * sizeof(Bvh8Node) + packs.size() * sizeof(Triangle8) + pack_prims.size() * sizeof(std::int32_t);
+  }
+};
+
+// Collapses `bvh2` (whose leaves hold at most 8 triangles, as
+// build_bvh2_binned_sah makes them) over `triangles`.
+Bvh8 collapse_to_bvh8(const Bvh2& bvh2, std::span<const Triangle> triangles);
+
+}  // namespace raybench

@@ -1,0 +1,72 @@
+// Single-ray traversal of a Bvh8: one 8-wide slab test per node (AVX2, or
+// its scalar fallback), children visited nearest first (closest hit) with
+// their entry distances kept on the stack so that a subtree farther than the
+// current hit is skipped when popped; leaves are tested 8 triangles at once.
+// Any hit returns at the first hit in the interval.
+#pragma once
+
+#include <limits>
+
+#include "raybench/bvh/bvh8.h"
+#include "raybench/math/inline.h"
+
+namespace raybench {
+
+namespace bvh8_detail {
+struct StackEntry {
+  std::uint32_t ref;
+  float entry;
+};
+// Each level pushes at most 7 entries; Bvh8::depth bounds the levels.
+inline constexpr std::size_t kStackPerLevel = 7;
+inline constexpr std::size_t kMaxDepth = 128;  // BVH2 depth is bounded by 96 (bvh2_traverse.h)
+}  // namespace bvh8_detail
+
+template <bool AnyHit>
+inline Hit traverse_bvh8(const Bvh8& bvh, const Ray& ray) {
+  using bvh8_detail::StackEntry;
+  Hit hit;
+  if (bvh.nodes.empty()) return hit;
+  const Slab::Precomputed r = Slab::precompute(ray);
+  float tmax = ray.tfar;
+  StackEntry stack[bvh8_detail::kStackPerLevel * bvh8_detail::kMaxDepth + 8];
+  int top = 0;
+  stack[top++] = {0, r.tnear};
+  while (top > 0) {
+    const StackEntry e = stack[--top];
+    if (!(e.entry <= tmax)) continue;  // a hit closer than this subtree was found meanwhile
+    if (e.ref & Bvh8::kLeafBit) {
+      const std::uint32_t pack = e.ref & ~Bvh8::kLeafBit;
+      TriangleHit th;
+      const int lane = intersect8(ray, tmax, bvh.packs[pack], th);
+      if (lane >= 0) {
+        tmax = th.t;
+        hit = {th.t, bvh.pack_prims[8 * pack + static_cast<std::uint32_t>(lane)], th.u, th.v};
+        if (AnyHit) return hit;
+      }
+      continue;
+    }
+    const Bvh8Node& node = bvh.nodes[e.ref];
+    alignas(32) float entry[8];
+    unsigned mask = intersect8(r, tmax, node.bounds, entry);
+    // Push the hit children farthest first, so the nearest is popped next
+    // (insertion into a small sorted run on top of the stack).
+    const int base = top;
+    for (; mask; mask &= mask - 1) {
+      const int lane = __builtin_ctz(mask);
+      const StackEntry child{node.child[lane], entry[lane]};
+      int i = top++;
+      while (i > base && stack[i - 1].entry < child.entry) {
+        stack[i] = stack[i - 1];
+        --i;
+      }
+      stack[i] = child;
+    }
+  }
+  return hit;
+}
+
+inline Hit intersect_bvh8(const Bvh8& bvh, const Ray& ray) { return traverse_bvh8<false>(bvh, ray); }
+inline bool occluded_bvh8(const Bvh8& bvh, const Ray& ray) { return traverse_bvh8<true>(bvh, ray).hit(); }
+
+}  // namespace raybench

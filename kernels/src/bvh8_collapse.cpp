@@ -1,0 +1,88 @@
+#include <algorithm>
+#include <stdexcept>
+
+#include "raybench/bvh/bvh8.h"
+
+namespace raybench {
+namespace {
+
+class Collapser {
+ public:
+  Collapser(const Bvh2& bvh2, std::span<const Triangle> triangles, Bvh8& out)
+      : bvh2_(bvh2), triangles_(triangles), out_(out) {}
+
+  // A BVH2 leaf becomes one pack.
+  std::uint32_t make_pack(const Bvh2Node& leaf) {
+    if (leaf.prim_count > 8) throw std::logic_error("collapse_to_bvh8: a BVH2 leaf holds more than 8 triangles");
+    Triangle tris[8];
+    for (std::uint32_t i = 0; i < leaf.prim_count; ++i) tris[i] = triangles_[bvh2_.prim_ids[leaf.first_index + i]];
+    const auto index = static_cast<std::uint32_t>(out_.packs.size());
+    out_.packs.push_back(Triangle8::pack({tris, leaf.prim_count}));
+    for (std::uint32_t i = 0; i < 8; ++i)
+      out_.pack_prims.push_back(i < leaf.prim_count ? static_cast<std::int32_t>(bvh2_.prim_ids[leaf.first_index + i]) : -1);
+    return Bvh8::kLeafBit | index;
+  }
+
+  // Turns the BVH2 subtree at `n2` (an inner node) into a Bvh8 node; returns its index.
+  std::uint32_t collapse(std::uint32_t n2, std::size_t level) {
+    out_.depth = std::max(out_.depth, level);
+    const auto index = static_cast<std::uint32_t>(out_.nodes.size());
+    out_.nodes.emplace_back();
+    std::vector<std::uint32_t> kids{bvh2_.nodes[n2].first_index, bvh2_.nodes[n2].first_index + 1};
+    while (kids.size() < 8) {
+      int best = -1;
+      float best_area = -1.0f;
+      for (std::size_t i = 0; i < kids.size(); ++i) {
+        const Bvh2Node& k = bvh2_.nodes[kids[i]];
+        if (!k.is_leaf() && k.bounds.half_area() > best_area) {
+          best_area = k.bounds.half_area();
+          best = static_cast<int>(i);
+        }
+      }
+      if (best < 0) break;
+      const std::uint32_t opened = kids[static_cast<std::size_t>(best)];
+      kids[static_cast<std::size_t>(best)] = bvh2_.nodes[opened].first_index;
+      kids.push_back(bvh2_.nodes[opened].first_index + 1);
+    }
+    BBox boxes[8];
+    std::uint32_t children[8];
+    for (std::size_t i = 0; i < 8; ++i) children[i] = Bvh8::kEmptyChild;
+    for (std::size_t i = 0; i < kids.size(); ++i) {
+      const Bvh2Node& k = bvh2_.nodes[kids[i]];
+      boxes[i] = k.bounds;
+      children[i] = k.is_leaf() ? make_pack(k) : collapse(kids[i], level + 1);  // may grow out_.nodes
+    }
+    Bvh8Node& node = out_.nodes[index];
+    node.bounds = BBox8::pack({boxes, kids.size()});
+    std::copy(children, children + 8, node.child);
+    return index;
+  }
+
+ private:
+  const Bvh2& bvh2_;
+  std::span<const Triangle> triangles_;
+  Bvh8& out_;
+};
+
+}  // namespace
+
+Bvh8 collapse_to_bvh8(const Bvh2& bvh2, std::span<const Triangle> triangles) {
+  Bvh8 out;
+  Collapser c(bvh2, triangles, out);
+  if (triangles.empty()) return out;  // no nodes: traversal returns at once
+  const Bvh2Node& root = bvh2.nodes[0];
+  if (root.is_leaf()) {
+    // A single leaf: a root node with one child.
+    out.nodes.emplace_back();
+    const std::uint32_t pack = c.make_pack(root);
+    const BBox box = root.bounds;
+    out.nodes[0].bounds = BBox8::pack({&box, 1});
+    std::fill(out.nodes[0].child, out.nodes[0].child + 8, Bvh8::kEmptyChild);
+    out.nodes[0].child[0] = pack;
+  } else {
+    c.collapse(0, 0);
+  }
+  return out;
+}
+
+}  // namespace raybench

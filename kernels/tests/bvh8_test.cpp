@@ -1,0 +1,145 @@
+// Specification of the 8-wide BVH (bvh/bvh8.h, bvh/bvh8_traverse.h): the
+// collapse keeps every triangle exactly once under bounds that contain it,
+// and traversal answers exactly as testing every triangle does.
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "raybench/bvh/bvh8_traverse.h"
+#include "raybench/geometry/uv_sphere.h"
+
+namespace raybench {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+std::vector<Triangle> random_soup(std::size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> pos(-10.0f, 10.0f), off(-1.0f, 1.0f);
+  std::vector<Triangle> tris;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3f c{pos(rng), pos(rng), pos(rng)};
+    tris.push_back({c, c + Vec3f{off(rng), off(rng), off(rng)}, c + Vec3f{off(rng), off(rng), off(rng)}});
+  }
+  tris.push_back({{1, 1, 1}, {1, 1, 1}, {2, 2, 2}});  // degenerate ones stay in the tree
+  return tris;
+}
+
+Bvh8 build(const std::vector<Triangle>& tris) { return collapse_to_bvh8(build_bvh2_binned_sah(tris), tris); }
+
+BBox lane_box(const BBox8& b, int lane) {
+  BBox box;
+  for (int a = 0; a < 3; ++a) {
+    box.lower[a] = b.lower[a][lane];
+    box.upper[a] = b.upper[a][lane];
+  }
+  return box;
+}
+
+// Walks the tree checking bounds; counts how often each triangle appears.
+void check(const Bvh8& bvh, const std::vector<Triangle>& tris, std::uint32_t node, const BBox& parent,
+           std::vector<int>& seen) {
+  for (int lane = 0; lane < 8; ++lane) {
+    const std::uint32_t child = bvh.nodes[node].child[lane];
+    const BBox box = lane_box(bvh.nodes[node].bounds, lane);
+    if (child == Bvh8::kEmptyChild) {
+      EXPECT_TRUE(box.empty());
+      continue;
+    }
+    EXPECT_TRUE(parent.contains(box));
+    if (child & Bvh8::kLeafBit) {
+      const std::uint32_t pack = child & ~Bvh8::kLeafBit;
+      for (int i = 0; i < 8; ++i) {
+        const std::int32_t id = bvh.pack_prims[8 * pack + i];
+        if (id < 0) continue;
+        ++seen[static_cast<std::size_t>(id)];
+        BBox t;
+        t.extend(tris[id].v0);
+        t.extend(tris[id].v1);
+        t.extend(tris[id].v2);
+        EXPECT_TRUE(box.contains(t)) << "triangle " << id;
+      }
+    } else {
+      check(bvh, tris, child, box, seen);
+    }
+  }
+}
+
+TEST(Bvh8, EveryTriangleInExactlyOneLeafUnderBoundsThatContainIt) {
+  for (std::size_t n : {1u, 7u, 9u, 5000u}) {
+    const auto tris = random_soup(n, 1);
+    const Bvh8 bvh = build(tris);
+    std::vector<int> seen(tris.size(), 0);
+    BBox everything;
+    everything.extend(Vec3f{-1e9f, -1e9f, -1e9f});
+    everything.extend(Vec3f{1e9f, 1e9f, 1e9f});
+    check(bvh, tris, 0, everything, seen);
+    for (std::size_t i = 0; i < tris.size(); ++i) EXPECT_EQ(seen[i], 1) << "triangle " << i << " of " << tris.size();
+    EXPECT_LT(bvh.depth, 40u);
+  }
+}
+
+Hit brute_force(const std::vector<Triangle>& tris, const Ray& ray) {
+  Hit best;
+  float tmax = ray.tfar;
+  for (std::size_t i = 0; i < tris.size(); ++i) {
+    TriangleHit h;
+    if (MollerTrumbore::intersect(ray, tmax, tris[i], h)) {
+      tmax = h.t;
+      best = {h.t, static_cast<std::int32_t>(i), h.u, h.v};
+    }
+  }
+  return best;
+}
+
+TEST(Bvh8, ClosestAndAnyHitMatchBruteForce) {
+  const auto tris = random_soup(4000, 2);
+  const Bvh8 bvh = build(tris);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), len(0.0f, 25.0f);
+  int hits = 0;
+  for (int i = 0; i < 4000; ++i) {
+    Ray r{{u(rng) * 15, u(rng) * 15, u(rng) * 15}, 0.0f, normalize(Vec3f{u(rng), u(rng), u(rng)}), kInf};
+    if (i % 2) r.tfar = len(rng);
+    const Hit expected = brute_force(tris, r);
+    const Hit got = intersect_bvh8(bvh, r);
+    ASSERT_EQ(got.hit(), expected.hit()) << "ray " << i;
+    EXPECT_EQ(occluded_bvh8(bvh, r), expected.hit()) << "ray " << i;
+    if (!expected.hit()) continue;
+    ++hits;
+    EXPECT_EQ(got.t, expected.t) << "ray " << i;
+    if (got.prim != expected.prim) EXPECT_EQ(got.t, expected.t);  // an exact tie: either is right
+    else {
+      EXPECT_EQ(got.u, expected.u);
+      EXPECT_EQ(got.v, expected.v);
+    }
+  }
+  EXPECT_GT(hits, 500);  // the comparison covers many hits, not only misses
+}
+
+TEST(Bvh8, FindsTheClosedSphereFromInsideAndNothingOutsideIt) {
+  std::vector<Triangle> tris;
+  append_uv_sphere(tris, {0, 0, 0}, 1.0f, 24, 48);
+  const Bvh8 bvh = build(tris);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int i = 0; i < 2000; ++i) {
+    const Ray r{{u(rng) * 0.5f, u(rng) * 0.5f, u(rng) * 0.5f}, 0.0f, normalize(Vec3f{u(rng), u(rng), u(rng)}), kInf};
+    const Hit h = intersect_bvh8(bvh, r);
+    ASSERT_TRUE(h.hit()) << "ray " << i;
+    EXPECT_NEAR(length(r.org + r.dir * h.t), 1.0f, 0.02f);
+  }
+  const Ray away{{3, 0, 0}, 0.0f, {1, 0, 0}, kInf};
+  EXPECT_FALSE(intersect_bvh8(bvh, away).hit());
+}
+
+TEST(Bvh8, EmptyInputBuildsATreeThatNothingHits) {
+  const std::vector<Triangle> none;
+  const Bvh8 bvh = build(none);
+  EXPECT_FALSE(intersect_bvh8(bvh, Ray{{0, 0, 0}, 0.0f, {0, 0, 1}, kInf}).hit());
+  EXPECT_FALSE(occluded_bvh8(bvh, Ray{{0, 0, 0}, 0.0f, {0, 0, 1}, kInf}));
+}
+
+}  // namespace
+}  // namespace raybench
