@@ -67,8 +67,9 @@ TEST_P(EveryBackend, OcclusionRespectsTheInterval) {
 }
 
 TEST_P(EveryBackend, NegativeTnearIsRaisedToZero) {
-  // The origin is between the two layers; the square behind it must not count.
-  Ray r{{0.1f, 0.1f, -0.5f}, -10.0f, {0, 0, 1}, kInf};
+  // The origin is between the two layers; the triangle behind it must not
+  // count. (0.2, 0.1) is strictly inside triangle 0, off the shared diagonal.
+  Ray r{{0.2f, 0.1f, -0.5f}, -10.0f, {0, 0, 1}, kInf};
   std::vector<Hit> hits(1);
   backend_->intersect({&r, 1}, hits);
   EXPECT_EQ(hits[0].prim, 0);
