@@ -22,7 +22,7 @@ TEST(Suite, TheDefaultSuiteParsesAndIncludesTheMillionTriangleProceduralScene) {
     ASSERT_NE(s.find(interior), nullptr) << interior;
     EXPECT_TRUE(s.find(interior)->camera.has_value()) << interior << " needs its camera inside";
   }
-  EXPECT_EQ(s.settings.backends, (std::vector<std::string>{"embree", "bvh2"}));
+  EXPECT_EQ(s.settings.backends, (std::vector<std::string>{"embree", "bvh2", "bvh8"}));
 }
 
 TEST(Suite, PathsAreResolvedAgainstTheManifestsFolder) {
