@@ -73,6 +73,9 @@ def main(argv):
         baseline_meta = f.read()
     cpu = next((line.split("=", 1)[1].strip().strip('"') for line in baseline_meta.splitlines() if line.startswith("cpu")), "?")
 
+    with open(paths[0]) as f:
+        row_count = sum(1 for _ in f) - 1
+
     def summary(name, gates):
         failed = sum(1 for g in gates if not g[0])
         worst = min(g[2] for g in gates)
@@ -83,7 +86,7 @@ def main(argv):
         "",
         f"Made by `scripts/noise-experiment {runs}` on {datetime.date.today().isoformat()} (CPU: {cpu}, 2 cores, "
         "shared machine). The short CI suite (`meshes/ci.toml`: 4 small scenes, 32,768 rays per ray set, "
-        "9 interleaved repetitions, 45 rows) ran "
+        f"9 interleaved repetitions, {row_count} rows) ran "
         f"{runs} times on one build, with no change in between, so every gate failure below is a false alarm. "
         "Thresholds: `results/gate.toml` (ratio to Embree may fall at most 10 %, and only a fall the exact "
         "Mann–Whitney U test calls real at p < 0.01 counts).",
