@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "bvh_test_util.h"
+
 #include "raybench/bvh/bvh2.h"
 #include "raybench/bvh/bvh2_traverse.h"
 #include "raybench/prim/triangle_mt.h"
@@ -14,19 +16,8 @@
 namespace raybench {
 namespace {
 
-std::vector<Triangle> random_soup(std::size_t n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> pos(-10.0f, 10.0f), off(-1.0f, 1.0f);
-  std::vector<Triangle> tris;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3f c{pos(rng), pos(rng), pos(rng)};
-    tris.push_back({c, c + Vec3f{off(rng), off(rng), off(rng)}, c + Vec3f{off(rng), off(rng), off(rng)}});
-  }
-  // Degenerate ones are part of real meshes (conference.ply: 16 %): keep some.
-  tris.push_back({{1, 1, 1}, {1, 1, 1}, {2, 2, 2}});
-  tris.push_back({{0, 0, 0}, {1, 1, 1}, {2, 2, 2}});
-  return tris;
-}
+using testing::brute_force_closest;
+using testing::random_soup;
 
 BBox bounds_of(const Triangle& t) {
   BBox b;
@@ -59,19 +50,6 @@ void expect_valid(const Bvh2& bvh, const std::vector<Triangle>& tris) {
   for (std::size_t i = 0; i < tris.size(); ++i) EXPECT_EQ(seen[i], 1) << "triangle " << i << " in " << seen[i] << " leaves";
   EXPECT_TRUE(std::isfinite(bvh.sah_cost()));
   EXPECT_GT(bvh.sah_cost(), 0.0);
-}
-
-Hit brute_force(const std::vector<Triangle>& tris, const Ray& ray) {
-  Hit best;
-  float tmax = ray.tfar;
-  for (std::size_t i = 0; i < tris.size(); ++i) {
-    TriangleHit h;
-    if (MollerTrumbore::intersect(ray, tmax, tris[i], h)) {
-      tmax = h.t;
-      best = {h.t, static_cast<std::int32_t>(i), h.u, h.v};
-    }
-  }
-  return best;
 }
 
 std::vector<MollerTrumbore::Prepared> prepare(const Bvh2& bvh, const std::vector<Triangle>& tris) {
@@ -111,7 +89,7 @@ TEST(Bvh2, ClosestHitMatchesBruteForce) {
     Ray r;
     r.org = {u(rng) * 15, u(rng) * 15, u(rng) * 15};
     r.dir = normalize(Vec3f{u(rng), u(rng), u(rng)});
-    const Hit expected = brute_force(tris, r);
+    const Hit expected = brute_force_closest(tris, r);
     const Hit got = intersect_bvh2<MollerTrumbore>(bvh, prepared, r);
     ASSERT_EQ(got.hit(), expected.hit()) << "ray " << i;
     if (!expected.hit()) continue;
@@ -137,7 +115,7 @@ TEST(Bvh2, AnyHitMatchesBruteForceWithinTheInterval) {
     r.org = {u(rng) * 15, u(rng) * 15, u(rng) * 15};
     r.dir = normalize(Vec3f{u(rng), u(rng), u(rng)});
     r.tfar = len(rng);
-    const bool expected = brute_force(tris, r).hit();
+    const bool expected = brute_force_closest(tris, r).hit();
     ASSERT_EQ(occluded_bvh2<MollerTrumbore>(bvh, prepared, r), expected) << "ray " << i;
     occluded += expected;
   }

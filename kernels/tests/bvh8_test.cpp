@@ -6,25 +6,18 @@
 
 #include <gtest/gtest.h>
 
+#include "bvh_test_util.h"
+
 #include "raybench/bvh/bvh8_traverse.h"
 #include "raybench/geometry/uv_sphere.h"
 
 namespace raybench {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
+using testing::brute_force_closest;
+using testing::random_soup;
 
-std::vector<Triangle> random_soup(std::size_t n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> pos(-10.0f, 10.0f), off(-1.0f, 1.0f);
-  std::vector<Triangle> tris;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3f c{pos(rng), pos(rng), pos(rng)};
-    tris.push_back({c, c + Vec3f{off(rng), off(rng), off(rng)}, c + Vec3f{off(rng), off(rng), off(rng)}});
-  }
-  tris.push_back({{1, 1, 1}, {1, 1, 1}, {2, 2, 2}});  // degenerate ones stay in the tree
-  return tris;
-}
+constexpr float kInf = std::numeric_limits<float>::infinity();
 
 Bvh8 build(const std::vector<Triangle>& tris) { return collapse_to_bvh8(build_bvh2_binned_sah(tris), tris); }
 
@@ -80,19 +73,6 @@ TEST(Bvh8, EveryTriangleInExactlyOneLeafUnderBoundsThatContainIt) {
   }
 }
 
-Hit brute_force(const std::vector<Triangle>& tris, const Ray& ray) {
-  Hit best;
-  float tmax = ray.tfar;
-  for (std::size_t i = 0; i < tris.size(); ++i) {
-    TriangleHit h;
-    if (MollerTrumbore::intersect(ray, tmax, tris[i], h)) {
-      tmax = h.t;
-      best = {h.t, static_cast<std::int32_t>(i), h.u, h.v};
-    }
-  }
-  return best;
-}
-
 TEST(Bvh8, ClosestAndAnyHitMatchBruteForce) {
   const auto tris = random_soup(4000, 2);
   const Bvh8 bvh = build(tris);
@@ -102,7 +82,7 @@ TEST(Bvh8, ClosestAndAnyHitMatchBruteForce) {
   for (int i = 0; i < 4000; ++i) {
     Ray r{{u(rng) * 15, u(rng) * 15, u(rng) * 15}, 0.0f, normalize(Vec3f{u(rng), u(rng), u(rng)}), kInf};
     if (i % 2) r.tfar = len(rng);
-    const Hit expected = brute_force(tris, r);
+    const Hit expected = brute_force_closest(tris, r);
     const Hit got = intersect_bvh8(bvh, r);
     ASSERT_EQ(got.hit(), expected.hit()) << "ray " << i;
     EXPECT_EQ(occluded_bvh8(bvh, r), expected.hit()) << "ray " << i;
