@@ -1,6 +1,7 @@
 #include <functional>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "backend.h"
 #include "backends/backend_families.h"
@@ -39,9 +40,10 @@ std::unique_ptr<Backend> make_backend(const std::string& name, const BackendConf
   for (const Family& f : families()) {
     if (f.name == parts[0]) return f.make(name, {parts.begin() + 1, parts.end()}, config);
   }
-  std::string known;
-  for (const Family& f : families()) known += (known.empty() ? "" : ", ") + f.name;
-  throw InputError("", fmt::format("unknown backend '{}' (known families: {}; see 'raybench backends')", name, known));
+  std::vector<std::string> known;
+  for (const Family& f : families()) known.push_back(f.name);
+  throw InputError("", fmt::format("unknown backend '{}' (known families: {}; see 'raybench backends')", name,
+                                   fmt::join(known, ", ")));
 }
 
 std::vector<BackendInfo> list_backends() {

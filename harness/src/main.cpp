@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "agreement.h"
 #include "build_info.h"
@@ -30,12 +31,6 @@ namespace {
 const std::string kDefaultSuite = std::string(RAYBENCH_SOURCE_DIR) + "/meshes/default.toml";
 const std::string kDefaultOut = std::string(RAYBENCH_SOURCE_DIR) + "/results/latest.csv";
 const std::string kDefaultRaysDir = std::string(RAYBENCH_SOURCE_DIR) + "/results/rays";
-
-std::string join(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& e : v) s += (s.empty() ? "" : ", ") + e;
-  return s;
-}
 
 // A scene argument is a suite scene's name or a mesh path / proc: spec.
 struct SceneArg {
@@ -92,7 +87,7 @@ int run(int argc, char** argv) {
   run_cmd->add_option("--scene,-s", run_options.scenes,
                       "Scenes to run: names from the suite, mesh paths, or proc:<name> (default: every available suite scene)")
       ->delimiter(',');
-  run_cmd->add_option("--rayset,-r", run_raysets, "Ray sets: " + join(rayset_kind_names()) + " (default: the suite's)")
+  run_cmd->add_option("--rayset,-r", run_raysets, fmt::format("Ray sets: {} (default: the suite's)", fmt::join(rayset_kind_names(), ", ")))
       ->delimiter(',');
   run_cmd->add_option("--rays,-n", run_rays, "Rays per ray set (default: the suite's, 262144)");
   run_cmd->add_option("--backend,-b", run_backends, "Backends, e.g. embree,embree:high,bvh2 (see 'raybench backends')")
@@ -114,7 +109,7 @@ int run(int argc, char** argv) {
   std::uint64_t rays_seed = 1;
   CLI::App* rays_cmd = app.add_subcommand("rays", "Generate a ray set and store it as .npy, float32 (N, 8): ox oy oz tnear dx dy dz tfar");
   rays_cmd->add_option("--scene,-s", rays_scene, "Mesh path, proc:<name>, or a suite scene name (uses its camera)")->required();
-  rays_cmd->add_option("--kind,-k", rays_kind, "Ray set: " + join(rayset_kind_names()))->capture_default_str();
+  rays_cmd->add_option("--kind,-k", rays_kind, fmt::format("Ray set: {}", fmt::join(rayset_kind_names(), ", ")))->capture_default_str();
   rays_cmd->add_option("--count,-n", rays_count, "Number of rays")->capture_default_str()->check(CLI::PositiveNumber);
   rays_cmd->add_option("--seed", rays_seed, "Seed")->capture_default_str();
   rays_cmd->add_option("--suite", rays_suite, "Suite manifest to look scene names up in")->capture_default_str();

@@ -10,6 +10,7 @@
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "agreement.h"
 #include "backend.h"
@@ -262,18 +263,15 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
     }
   }
 
-  std::string thread_list, backend_list, rayset_list, scene_list;
-  for (int t : settings.threads) thread_list += (thread_list.empty() ? "" : ",") + std::to_string(t);
-  for (const auto& b : settings.backends) backend_list += (backend_list.empty() ? "" : ",") + b;
-  for (const auto& r : settings.raysets) rayset_list += (rayset_list.empty() ? "" : ",") + r;
-  for (const auto& s : scenes) scene_list += (scene_list.empty() ? "" : ",") + s.scene.name;
+  std::vector<std::string> scene_names;
+  for (const auto& s : scenes) scene_names.push_back(s.scene.name);
   const Metadata metadata = collect_metadata({
       {"command", options.command_line},
       {"suite", options.suite.path},
-      {"scenes", scene_list},
-      {"raysets", rayset_list},
-      {"backends", backend_list},
-      {"threads", thread_list},
+      {"scenes", fmt::format("{}", fmt::join(scene_names, ","))},
+      {"raysets", fmt::format("{}", fmt::join(settings.raysets, ","))},
+      {"backends", fmt::format("{}", fmt::join(settings.backends, ","))},
+      {"threads", fmt::format("{}", fmt::join(settings.threads, ","))},
       {"rays", std::to_string(settings.rays)},
       {"seed", std::to_string(settings.seed)},
       {"repetitions", std::to_string(settings.repetitions)},
