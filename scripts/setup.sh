@@ -10,7 +10,7 @@ export RAYBENCH_ROOT RAYBENCH_BUILD_DIR
 
 # Every Debian package raybench builds, tests or plots with.
 RAYBENCH_PACKAGES="cmake ninja-build g++ git pkg-config libembree-dev libassimp-dev assimp-utils assimp-testmodels \
-libeigen3-dev libbenchmark-dev libgtest-dev libtbb-dev libcli11-dev libfmt-dev libtomlplusplus-dev \
+libeigen3-dev libbenchmark-dev libgtest-dev libtbb-dev libcli11-dev libfmt-dev libtomlplusplus-dev libcgal-dev libgmp-dev libmpfr-dev \
 python3 python3-numpy python3-matplotlib"
 
 raybench_install_packages() {

@@ -1,51 +1,19 @@
 #include "results_csv.h"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "atomic_file.h"
+#include "csv.h"
 #include "error.h"
 
 namespace raybench {
 namespace {
 
-std::string number(double v) { return std::isnan(v) ? std::string() : fmt::format("{:.6g}", v); }
-
-// Scene and backend names never contain commas or quotes in practice, but
-// a user's file name might: quote per RFC 4180 when needed.
-std::string text(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
-std::vector<std::string> split_csv_line(const std::string& line) {
-  std::vector<std::string> out;
-  std::string field;
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') field += '"', ++i;
-      else if (c == '"') quoted = false;
-      else field += c;
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      out.push_back(field);
-      field.clear();
-    } else {
-      field += c;
-    }
-  }
-  out.push_back(field);
-  return out;
-}
+std::string number(double v) { return csv_number(v); }
+std::string text(const std::string& s) { return csv_text(s); }
 
 }  // namespace
 
@@ -78,26 +46,7 @@ void write_results_csv(const std::string& path, const std::vector<ResultRow>& ro
 }
 
 std::vector<std::map<std::string, std::string>> read_results_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot be opened for reading");
-  std::string line;
-  if (!std::getline(in, line)) throw InputError(path, "empty file, expected a results CSV header");
-  const std::vector<std::string> header = split_csv_line(line);
-  for (const std::string& c : result_columns())
-    if (std::find(header.begin(), header.end(), c) == header.end()) throw InputError(path, "missing column '" + c + "'");
-  std::vector<std::map<std::string, std::string>> rows;
-  std::size_t line_number = 1;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (line.empty()) continue;
-    const std::vector<std::string> fields = split_csv_line(line);
-    if (fields.size() != header.size())
-      throw InputError(path, fmt::format("line {}: {} fields, header has {}", line_number, fields.size(), header.size()));
-    std::map<std::string, std::string> row;
-    for (std::size_t i = 0; i < header.size(); ++i) row[header[i]] = fields[i];
-    rows.push_back(std::move(row));
-  }
-  return rows;
+  return read_csv_rows(path, result_columns());
 }
 
 }  // namespace raybench
