@@ -24,4 +24,8 @@ std::unique_ptr<Backend> make_bvh8_backend(const std::string& name, const std::v
                                            const BackendConfig& config);
 std::vector<BackendInfo> bvh8_backend_names();
 
+std::unique_ptr<Backend> make_reference_backend(const std::string& name, const std::vector<std::string>& options,
+                                                const BackendConfig& config);
+std::vector<BackendInfo> reference_backend_names();
+
 }  // namespace raybench
