@@ -60,4 +60,9 @@ std::unique_ptr<Backend> make_backend(const std::string& name, const BackendConf
 // Every name make_backend accepts in its canonical forms, for --help.
 std::vector<BackendInfo> list_backends();
 
+// The accuracy class of a backend name (as listed; options the list does not
+// spell out, such as a trailing ":robust", are looked through): "fast",
+// "epsilon", "watertight", "reference", "exact".
+std::string backend_accuracy_class(const std::string& name);
+
 }  // namespace raybench

@@ -56,4 +56,16 @@ std::vector<BackendInfo> list_backends() {
   return out;
 }
 
+std::string backend_accuracy_class(const std::string& name) {
+  const std::vector<BackendInfo> all = list_backends();
+  std::string wanted = name;
+  for (;;) {
+    for (const BackendInfo& b : all)
+      if (b.name == wanted) return b.accuracy;
+    const std::size_t colon = wanted.rfind(':');
+    if (colon == std::string::npos) return "fast";
+    wanted.resize(colon);
+  }
+}
+
 }  // namespace raybench

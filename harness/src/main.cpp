@@ -41,8 +41,7 @@ struct SceneArg {
 SceneArg resolve_scene(const std::string& arg, const Suite* suite) {
   SceneArg out;
   out.entry = suite ? suite->find(arg) : nullptr;
-  out.scene = load_scene(out.entry ? out.entry->path : arg);
-  if (out.entry) out.scene.name = out.entry->name;
+  out.scene = out.entry ? load_suite_scene(*out.entry) : load_scene(arg);
   return out;
 }
 
@@ -102,6 +101,9 @@ int run(int argc, char** argv) {
   run_cmd->add_option("--rays-dir", run_options.rays_dir, "Where ray sets are stored and reused")->capture_default_str();
   run_cmd->add_flag("--no-interleave", no_interleave, "Run each case's repetitions back to back instead of interleaved");
   run_cmd->add_flag("--list", list_only, "List the suite's scenes and whether they are available, then exit");
+  run_cmd->add_option("--accuracy", run_options.accuracy_csv,
+                      "Also judge every ray with the exact referee and write the accuracy CSV here "
+                      "(e.g. results/accuracy.csv; see scripts/accuracy)");
 
   // raybench rays
   std::string rays_scene, rays_kind = "primary", rays_out, rays_suite = kDefaultSuite;

@@ -1,6 +1,9 @@
 #include "rayset.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <Eigen/Dense>
@@ -50,9 +53,12 @@ std::uint64_t stream_of(RaySetKind kind) { return hash_string(to_string(kind).c_
 
 }  // namespace
 
-constexpr RaySetKind kAllKinds[] = {RaySetKind::kPrimary,           RaySetKind::kDiffuse,         RaySetKind::kShadow,
-                                    RaySetKind::kUniform,           RaySetKind::kClosedInsideRandom, RaySetKind::kSharedEdgeAimed,
-                                    RaySetKind::kVertexAimed};
+constexpr RaySetKind kAllKinds[] = {
+    RaySetKind::kPrimary,          RaySetKind::kDiffuse,         RaySetKind::kShadow,          RaySetKind::kUniform,
+    RaySetKind::kClosedInsideRandom, RaySetKind::kSharedEdgeAimed, RaySetKind::kVertexAimed,   RaySetKind::kTinyTriangles,
+    RaySetKind::kGrazing,          RaySetKind::kDegenerateTriangles, RaySetKind::kAxisParallel, RaySetKind::kBehindOrigin,
+    RaySetKind::kInvalid,          RaySetKind::kDirectionScaling, RaySetKind::kBvhConservative, RaySetKind::kReintersection,
+    RaySetKind::kControlRandom,    RaySetKind::kFarOrigin};
 
 std::string to_string(RaySetKind kind) {
   switch (kind) {
@@ -63,12 +69,27 @@ std::string to_string(RaySetKind kind) {
     case RaySetKind::kClosedInsideRandom: return "closed-inside-random";
     case RaySetKind::kSharedEdgeAimed: return "shared-edge-aimed";
     case RaySetKind::kVertexAimed: return "vertex-aimed";
+    case RaySetKind::kTinyTriangles: return "tiny-triangles";
+    case RaySetKind::kGrazing: return "grazing";
+    case RaySetKind::kDegenerateTriangles: return "degenerate-triangles";
+    case RaySetKind::kAxisParallel: return "axis-parallel-signed-zero";
+    case RaySetKind::kBehindOrigin: return "behind-origin";
+    case RaySetKind::kInvalid: return "invalid-rays";
+    case RaySetKind::kDirectionScaling: return "direction-scaling";
+    case RaySetKind::kBvhConservative: return "bvh-conservative";
+    case RaySetKind::kReintersection: return "reintersection";
+    case RaySetKind::kControlRandom: return "control-random";
+    case RaySetKind::kFarOrigin: return "far-origin";
   }
   return "?";
 }
 
 bool is_must_hit(RaySetKind kind) {
   return kind == RaySetKind::kClosedInsideRandom || kind == RaySetKind::kSharedEdgeAimed || kind == RaySetKind::kVertexAimed;
+}
+
+bool has_sources(RaySetKind kind) {
+  return kind == RaySetKind::kDiffuse || kind == RaySetKind::kShadow || kind == RaySetKind::kReintersection;
 }
 
 std::string to_string(Query query) { return query == Query::kIntersect ? "intersect" : "occluded"; }
@@ -133,18 +154,20 @@ std::uint64_t RayGenerator::key(const RaySetSpec& spec) const {
   return mix64(h ^ mix64(stream_of(spec.kind) ^ mix64(spec.count ^ mix64(spec.seed))));
 }
 
-std::vector<Ray> RayGenerator::generate(const RaySetSpec& spec) const {
+std::vector<Ray> RayGenerator::generate(const RaySetSpec& spec, std::vector<std::int32_t>* sources) const {
   const Camera camera = spec.camera.value_or(default_camera());
+  if (sources) sources->assign(spec.count, kNoHit);
   switch (spec.kind) {
     case RaySetKind::kPrimary: return primary(spec, camera);
     case RaySetKind::kDiffuse:
-    case RaySetKind::kShadow: return from_primary_hits(spec, camera);
+    case RaySetKind::kShadow:
+    case RaySetKind::kReintersection: return from_primary_hits(spec, camera, sources);
     case RaySetKind::kUniform: return uniform(spec);
     case RaySetKind::kClosedInsideRandom:
     case RaySetKind::kSharedEdgeAimed:
     case RaySetKind::kVertexAimed: return must_hit(spec);
+    default: return extreme(spec);
   }
-  return {};
 }
 
 // A jittered W x H grid in scanline order (coherent, as a renderer issues
@@ -164,7 +187,8 @@ std::vector<Ray> RayGenerator::primary(const RaySetSpec& spec, const Camera& cam
 
 // One ray per primary hit, primary rays through uniformly random pixels,
 // drawn in blocks until `count` hits are found.
-std::vector<Ray> RayGenerator::from_primary_hits(const RaySetSpec& spec, const Camera& camera) const {
+std::vector<Ray> RayGenerator::from_primary_hits(const RaySetSpec& spec, const Camera& camera,
+                                                 std::vector<std::int32_t>* sources) const {
   const Vec3f light = spec.light.value_or(default_light());
   const std::uint64_t stream = stream_of(spec.kind);
   std::vector<Ray> out;
@@ -172,7 +196,9 @@ std::vector<Ray> RayGenerator::from_primary_hits(const RaySetSpec& spec, const C
   const std::size_t block = std::max<std::size_t>(spec.count, 1024);
   const std::size_t max_candidates = 64 * block;
   std::vector<Ray> candidates(block);
+  std::vector<std::int32_t> candidate_sources(block);
   std::vector<std::uint8_t> made(block);
+  if (sources) sources->clear();
   for (std::size_t first = 0; out.size() < spec.count; first += block) {
     if (first >= max_candidates)
       throw InputError(scene_.name, fmt::format("the camera sees almost nothing of the scene ({} of {} primary rays hit); "
@@ -194,7 +220,15 @@ std::vector<Ray> RayGenerator::from_primary_hits(const RaySetSpec& spec, const C
       const Eigen::Vector3d p = (1.0 - hit.u - hit.v) * v0 + hit.u * v1 + hit.v * v2;
       Ray r;
       r.org = offset_ray_origin(to_vec(p), to_vec(n));
-      if (spec.kind == RaySetKind::kDiffuse) {
+      // Reintersection (G18): odd rays toward a random point of the bounds,
+      // which may lie behind the surface; even rays like diffuse ones.
+      if (spec.kind == RaySetKind::kReintersection && (first + j) % 2 == 1) {
+        const Eigen::Vector3d target = to_eigen(bounds_.lower) + Eigen::Vector3d(rng.next_double(), rng.next_double(),
+                                                                                 rng.next_double()).cwiseProduct(to_eigen(bounds_.extent()));
+        const Eigen::Vector3d d = target - to_eigen(r.org);
+        if (!(d.norm() > 0.0)) return;
+        r.dir = to_vec(d.normalized());
+      } else if (spec.kind != RaySetKind::kShadow) {
         // Cosine-weighted hemisphere (Malley's method).
         const double r1 = rng.next_double(), phi = 2.0 * std::numbers::pi * rng.next_double();
         const double radius = std::sqrt(r1);
@@ -210,10 +244,14 @@ std::vector<Ray> RayGenerator::from_primary_hits(const RaySetSpec& spec, const C
         r.tfar = static_cast<float>(distance);
       }
       candidates[j] = r;
+      candidate_sources[j] = hit.prim;
       made[j] = 1;
     });
-    for (std::size_t j = 0; j < block && out.size() < spec.count; ++j)
-      if (made[j]) out.push_back(candidates[j]);
+    for (std::size_t j = 0; j < block && out.size() < spec.count; ++j) {
+      if (!made[j]) continue;
+      out.push_back(candidates[j]);
+      if (sources) sources->push_back(candidate_sources[j]);
+    }
   }
   return out;
 }
@@ -273,6 +311,166 @@ std::vector<Ray> RayGenerator::must_hit(const RaySetSpec& spec) const {
         target = corners[corner] + (corners[(corner + 1) % 3] - corners[corner]) * along;  // the float lerp
       }
       r.dir = target - r.org;  // unnormalised on purpose: d = target - o, as G02/G03 define it
+    }
+    rays[i] = r;
+  });
+  return rays;
+}
+
+
+namespace {
+
+Eigen::Vector3d uniform_direction(Rng& rng) {
+  const double z = 2.0 * rng.next_double() - 1.0, phi = 2.0 * std::numbers::pi * rng.next_double();
+  const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
+  return {s * std::cos(phi), z, s * std::sin(phi)};
+}
+
+// A point of the triangle with every barycentric coordinate >= margin.
+Eigen::Vector3d interior_point(const Triangle& t, Rng& rng, double margin) {
+  double b1 = rng.next_double(), b2 = rng.next_double();
+  if (b1 + b2 > 1.0) b1 = 1.0 - b1, b2 = 1.0 - b2;
+  const double scale = 1.0 - 3.0 * margin;
+  b1 = margin + scale * b1;
+  b2 = margin + scale * b2;
+  return (1.0 - b1 - b2) * to_eigen(t.v0) + b1 * to_eigen(t.v1) + b2 * to_eigen(t.v2);
+}
+
+double longest_edge(const Triangle& t) {
+  return std::max({(to_eigen(t.v1) - to_eigen(t.v0)).norm(), (to_eigen(t.v2) - to_eigen(t.v1)).norm(),
+                   (to_eigen(t.v0) - to_eigen(t.v2)).norm()});
+}
+
+// G15's corruptions of a valid ray, cycled through by ray index.
+Ray invalidate(Ray r, std::size_t i) {
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN(), kInf = std::numeric_limits<float>::infinity();
+  constexpr std::size_t kFieldPatterns = 6 * 3;  // each of org.xyz and dir.xyz: NaN, +Inf, -Inf
+  const std::size_t pattern = i % (kFieldPatterns + 6);
+  if (pattern < kFieldPatterns) {
+    float* fields[6] = {&r.org.x, &r.org.y, &r.org.z, &r.dir.x, &r.dir.y, &r.dir.z};
+    const float values[3] = {kNaN, kInf, -kInf};
+    *fields[pattern / 3] = values[pattern % 3];
+    return r;
+  }
+  switch (pattern - kFieldPatterns) {
+    case 0: r.tnear = kNaN; break;
+    case 1: r.tfar = kNaN; break;
+    case 2: r.tnear = 2.0f, r.tfar = 1.0f; break;  // empty interval
+    case 3: r.dir = {0.0f, 0.0f, 0.0f}; break;
+    case 4: r.org.x = 4.0e18f; break;  // beyond Embree's range (kLargestTraceableCoordinate)
+    default: r.dir = {-0.0f, -0.0f, -0.0f}; break;
+  }
+  return r;
+}
+
+}  // namespace
+
+// The extreme ray sets of ../shared/EXTREMES.md that work on any scene. Each
+// ray depends only on (seed, kind, index), like every other ray set.
+std::vector<Ray> RayGenerator::extreme(const RaySetSpec& spec) const {
+  std::vector<Ray> rays(spec.count);
+  const std::size_t triangles = scene_.triangles.size();
+  const Eigen::Vector3d lower = to_eigen(bounds_.lower), extent = to_eigen(bounds_.extent());
+  const Eigen::Vector3d center = to_eigen(bounds_.center());
+  const double radius = std::max(0.5 * extent.norm(), 1e-30);
+  const auto random_point_in_bounds = [&](Rng& rng) {
+    return Eigen::Vector3d(lower + Eigen::Vector3d(rng.next_double(), rng.next_double(), rng.next_double()).cwiseProduct(extent));
+  };
+  const auto outside_origin = [&](Rng& rng) { return Eigen::Vector3d(center + 1.5 * radius * uniform_direction(rng)); };
+  tbb::parallel_for(std::size_t{0}, spec.count, [&](std::size_t i) {
+    Rng rng(spec.seed, stream_of(spec.kind), i);
+    const Triangle& tri = scene_.triangles[rng.next_u64() % triangles];
+    Ray r;
+    switch (spec.kind) {
+      case RaySetKind::kTinyTriangles:
+      case RaySetKind::kDegenerateTriangles: {
+        // From a random direction, 1 to 10 triangle sizes away (and at least
+        // one unit, so tiny triangles are seen from a normal distance too).
+        const Eigen::Vector3d target = interior_point(tri, rng, 0.1);
+        const double distance = std::max(longest_edge(tri), 1e-30) * (1.0 + 9.0 * rng.next_double()) + (i % 2 ? 1.0 : 0.0);
+        r.org = to_vec(target - distance * uniform_direction(rng));
+        r.dir = to_vec(target) - r.org;
+        break;
+      }
+      case RaySetKind::kGrazing: {
+        const Eigen::Vector3d v0 = to_eigen(tri.v0), e1 = to_eigen(tri.v1) - v0, e2 = to_eigen(tri.v2) - v0;
+        Eigen::Vector3d n = e1.cross(e2);
+        if (!(n.norm() > 0.0)) n = Eigen::Vector3d::UnitY();  // degenerate: no plane to graze
+        n.normalize();
+        Eigen::Vector3d b1, b2;
+        basis(n, b1, b2);
+        const double alpha = std::pow(10.0, -2.0 - static_cast<double>(i % 5));  // 1e-2 ... 1e-6 rad
+        const double phi = 2.0 * std::numbers::pi * rng.next_double();
+        const Eigen::Vector3d d = std::cos(alpha) * (std::cos(phi) * b1 + std::sin(phi) * b2) +
+                                  std::sin(alpha) * (rng.next_u64() % 2 ? n : Eigen::Vector3d(-n));
+        const Eigen::Vector3d target = interior_point(tri, rng, 0.1);
+        r.org = to_vec(target - 2.0 * std::max(longest_edge(tri), 1e-30) * d);
+        r.dir = to_vec(d);
+        break;
+      }
+      case RaySetKind::kAxisParallel: {
+        // Direction pattern k of {-1, 0, +1}^3 minus the zero vector, each zero
+        // +0 or -0. The origin shares the target's coordinates along the zero
+        // components, so it lies exactly on the slab planes through the target
+        // (a vertex, i.e. a corner of every box holding it, or a point of the triangle).
+        const std::size_t k = i % 26, code = k < 13 ? k : k + 1;
+        const int c[3] = {static_cast<int>(code % 3) - 1, static_cast<int>(code / 3 % 3) - 1, static_cast<int>(code / 9) - 1};
+        const Eigen::Vector3d target = i % 3 == 0 ? to_eigen(tri.v0) : interior_point(tri, rng, 0.0);
+        const Vec3f t = to_vec(target);
+        float d[3], o[3];
+        const float tc[3] = {t.x, t.y, t.z};
+        const double distance = radius * (0.5 + rng.next_double());
+        for (int a = 0; a < 3; ++a) {
+          const bool negative_zero = rng.next_u64() % 2;
+          d[a] = c[a] == 0 ? (negative_zero ? -0.0f : 0.0f) : static_cast<float>(c[a]);
+          o[a] = c[a] == 0 ? tc[a] : static_cast<float>(tc[a] - distance * c[a]);
+        }
+        r.org = {o[0], o[1], o[2]};
+        r.dir = {d[0], d[1], d[2]};
+        break;
+      }
+      case RaySetKind::kBehindOrigin: {
+        const Eigen::Vector3d target = interior_point(tri, rng, 0.1);
+        const Eigen::Vector3d away = uniform_direction(rng);
+        r.org = to_vec(target + std::max(longest_edge(tri), 1e-30) * (1.0 + rng.next_double()) * away);
+        r.dir = to_vec(away);
+        break;
+      }
+      case RaySetKind::kInvalid: {
+        r.org = to_vec(outside_origin(rng));
+        r.dir = to_vec((random_point_in_bounds(rng) - to_eigen(r.org)).normalized());
+        r = invalidate(r, i);
+        break;
+      }
+      case RaySetKind::kDirectionScaling: {
+        const Eigen::Vector3d o = outside_origin(rng);
+        const double length = std::pow(10.0, std::array<double, 5>{-20, -7, 0, 7, 20}[i % 5]);
+        r.org = to_vec(o);
+        r.dir = to_vec((random_point_in_bounds(rng) - o).normalized() * length);
+        break;
+      }
+      case RaySetKind::kBvhConservative: {
+        const Vec3f corners[3] = {tri.v0, tri.v1, tri.v2};
+        const auto corner = rng.next_u64() % 3;
+        Vec3f target = corners[corner];
+        if (i % 2) target = corners[corner] + (corners[(corner + 1) % 3] - corners[corner]) * static_cast<float>(rng.next_double());
+        r.org = to_vec(outside_origin(rng));
+        r.dir = target - r.org;
+        break;
+      }
+      case RaySetKind::kControlRandom: {
+        r.org = to_vec(random_point_in_bounds(rng));
+        r.dir = to_vec(uniform_direction(rng));
+        break;
+      }
+      case RaySetKind::kFarOrigin: {
+        const double distance = std::pow(10.0, 5.0 + static_cast<double>(i % 3));  // 1e5, 1e6, 1e7 units
+        const Eigen::Vector3d o = center + distance * uniform_direction(rng);
+        r.org = to_vec(o);
+        r.dir = to_vec((random_point_in_bounds(rng) - o).normalized());
+        break;
+      }
+      default: break;
     }
     rays[i] = r;
   });

@@ -1,6 +1,9 @@
 #include "suite.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <set>
 
 #include <fmt/format.h>
@@ -73,6 +76,18 @@ class Reader {
     return v;
   }
 
+  std::array<double, 3> vec3d(const toml::node& node, const std::string& key) const {
+    const toml::array* array = node.as_array();
+    if (!array || array->size() != 3) fail(key, "expected [x, y, z]");
+    std::array<double, 3> v{};
+    for (std::size_t i = 0; i < 3; ++i) {
+      auto c = (*array)[i].value<double>();
+      if (!c || !std::isfinite(*c)) fail(key, "expected [x, y, z] finite numbers");
+      v[i] = *c;
+    }
+    return v;
+  }
+
   Camera camera(const toml::node& node, const std::string& key) const {
     const toml::table* t = node.as_table();
     if (!t) fail(key, "expected a table { position = [..], look_at = [..], up = [..], fov = deg }");
@@ -92,6 +107,41 @@ class Reader {
 };
 
 }  // namespace
+
+namespace {
+
+Vec3f moved(Vec3f v, double scale, const std::array<double, 3>& offset) {
+  return {static_cast<float>(scale * v.x + offset[0]), static_cast<float>(scale * v.y + offset[1]),
+          static_cast<float>(scale * v.z + offset[2])};
+}
+
+// Applies the transform to what the manifest gave for the untransformed scene.
+void move_entry(SuiteScene& scene) {
+  if (scene.camera) {
+    scene.camera->position = moved(scene.camera->position, scene.scale, scene.offset);
+    scene.camera->look_at = moved(scene.camera->look_at, scene.scale, scene.offset);
+  }
+  if (scene.light) scene.light = moved(*scene.light, scene.scale, scene.offset);
+  if (scene.inside) {
+    scene.inside->center = moved(scene.inside->center, scene.scale, scene.offset);
+    scene.inside->radius = static_cast<float>(scene.inside->radius * scene.scale);
+  }
+}
+
+}  // namespace
+
+Scene load_suite_scene(const SuiteScene& entry) {
+  Scene scene = load_scene(entry.path);
+  scene.name = entry.name;
+  if (entry.transformed()) {
+    for (Triangle& t : scene.triangles) {
+      t.v0 = moved(t.v0, entry.scale, entry.offset);
+      t.v1 = moved(t.v1, entry.scale, entry.offset);
+      t.v2 = moved(t.v2, entry.scale, entry.offset);
+    }
+  }
+  return scene;
+}
 
 bool SuiteScene::available() const {
   if (path.rfind(kProceduralPrefix, 0) == 0) return true;
@@ -160,12 +210,12 @@ Suite load_suite(const std::string& path) {
       const std::string key = fmt::format("scene[{}]", index++);
       const toml::table* t = e.as_table();
       if (!t) r.fail(key, "expected a table");
-      r.check_keys(*t, key, {"name", "path", "optional", "camera", "light", "inside", "raysets", "note"});
+      r.check_keys(*t, key, {"name", "path", "optional", "camera", "light", "inside", "raysets", "note", "scale", "offset", "sweep"});
       SuiteScene scene;
       scene.name = r.get<std::string>(*t, key + ".", "name", "");
       scene.path = r.get<std::string>(*t, key + ".", "path", "");
       if (scene.name.empty() || scene.path.empty()) r.fail(key, "needs a name and a path");
-      if (suite.find(scene.name)) r.fail(key + ".name", "duplicate scene name '" + scene.name + "'");
+      if (suite.find(scene.name) && !t->get("sweep")) r.fail(key + ".name", "duplicate scene name '" + scene.name + "'");
       if (scene.path.rfind(kProceduralPrefix, 0) != 0 && fs::path(scene.path).is_relative())
         scene.path = (base / scene.path).lexically_normal().string();
       scene.optional = r.get<bool>(*t, key + ".", "optional", false);
@@ -187,7 +237,48 @@ Suite load_suite(const std::string& path) {
           r.fail(key + ".raysets", e.what());
         }
       }
-      suite.scenes.push_back(std::move(scene));
+      scene.scale = r.get<double>(*t, key + ".", "scale", 1.0);
+      if (!(scene.scale > 0.0 && std::isfinite(scene.scale))) r.fail(key + ".scale", "must be a positive number");
+      if (const toml::node* o = t->get("offset")) scene.offset = r.vec3d(*o, key + ".offset");
+      const toml::node* sweep = t->get("sweep");
+      if (!sweep) {
+        move_entry(scene);
+        suite.scenes.push_back(std::move(scene));
+        continue;
+      }
+      // The stability sweep: one scene per (scale, offset), skipping those
+      // where float spacing at the offset exceeds max_quantisation * scale
+      // (the mesh would no longer be the same shape, nor the ball inside it).
+      const toml::table* w = sweep->as_table();
+      if (!w) r.fail(key + ".sweep", "expected { scales = [..], offsets = [[x, y, z], ..] }");
+      r.check_keys(*w, key + ".sweep", {"scales", "offsets", "max_quantisation"});
+      const toml::array* scales = w->get("scales") ? w->get("scales")->as_array() : nullptr;
+      if (!scales || scales->empty()) r.fail(key + ".sweep.scales", "expected a non-empty array of numbers");
+      std::vector<std::array<double, 3>> offsets{{0.0, 0.0, 0.0}};
+      if (const toml::node* os = w->get("offsets")) {
+        const toml::array* oa = os->as_array();
+        if (!oa || oa->empty()) r.fail(key + ".sweep.offsets", "expected an array of [x, y, z]");
+        offsets.clear();
+        for (const toml::node& o : *oa) offsets.push_back(r.vec3d(o, key + ".sweep.offsets"));
+      }
+      const double max_quantisation = r.get<double>(*w, key + ".sweep.", "max_quantisation", 1e-3);
+      for (const toml::node& sn : *scales) {
+        const auto sv = sn.value<double>();
+        if (!sv || !(*sv > 0.0)) r.fail(key + ".sweep.scales", "expected positive numbers");
+        for (const auto& o : offsets) {
+          const double far = std::max({std::fabs(o[0]), std::fabs(o[1]), std::fabs(o[2])});
+          const float f = static_cast<float>(far);
+          if (std::nextafter(f, std::numeric_limits<float>::infinity()) - f > max_quantisation * *sv) continue;
+          SuiteScene copy = scene;
+          copy.scale = *sv;
+          copy.offset = o;
+          copy.name = fmt::format("{}@s{:g}", scene.name, *sv);
+          if (far > 0.0) copy.name += fmt::format("@o{:g}_{:g}_{:g}", o[0], o[1], o[2]);
+          if (suite.find(copy.name)) r.fail(key + ".name", "duplicate scene name '" + copy.name + "'");
+          move_entry(copy);
+          suite.scenes.push_back(std::move(copy));
+        }
+      }
     }
   }
   if (suite.scenes.empty()) throw InputError(path, "the suite names no [[scene]]");

@@ -2,6 +2,7 @@
 // backends and settings a run uses. See README.md, "Suite manifests".
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -19,9 +20,17 @@ struct SuiteScene {
   std::optional<Vec3f> light;
   std::optional<InsideBall> inside;  // a closed mesh's inner ball: enables the must-hit ray sets
   std::vector<std::string> raysets;  // this scene's ray sets; empty: the suite's defaults
+  // Every vertex v becomes float(scale * v + offset) after loading; camera,
+  // light and inside ball (given for the untransformed scene) move with it.
+  double scale = 1.0;
+  std::array<double, 3> offset{0.0, 0.0, 0.0};
 
   bool available() const;
+  bool transformed() const { return scale != 1.0 || offset != std::array<double, 3>{0.0, 0.0, 0.0}; }
 };
+
+// Loads the scene an entry names, transformed and named as the entry says.
+Scene load_suite_scene(const SuiteScene& entry);
 
 struct SuiteSettings {
   std::size_t rays = 262144;
@@ -45,7 +54,8 @@ struct Suite {
 };
 
 // Throws InputError naming the file and key on syntax errors, unknown keys,
-// wrong types or duplicate scene names.
+// wrong types or duplicate scene names. A [[scene]] with a `sweep` table
+// (scales, offsets) becomes one scene per combination: the stability sweep.
 Suite load_suite(const std::string& path);
 
 }  // namespace raybench

@@ -7,11 +7,13 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "accuracy/judge.h"
 #include "agreement.h"
 #include "backend.h"
 #include "error.h"
@@ -19,6 +21,7 @@
 #include "metadata.h"
 #include "npy.h"
 #include "rayset.h"
+#include "referee/referee.h"
 #include "scene.h"
 #include "trace.h"
 
@@ -35,16 +38,20 @@ struct LoadedScene {
 struct RaySet {
   RaySetKind kind;
   std::vector<Ray> rays;
+  std::vector<std::int32_t> sources;   // accuracy runs, secondary rays: the triangle each starts from
+  std::vector<RefereeVerdict> truth;   // accuracy runs: the referee's verdict per ray
 };
 
 // Rays are stored under a name that carries everything they depend on, so a
 // later run (or a later commit) traces exactly the same rays.
+// With `sources`, the rays are made again (bit-identical) to learn where
+// each secondary ray starts; they are not stored in the ray file.
 std::vector<Ray> obtain_rays(const RayGenerator& generator, const Scene& scene, const RaySetSpec& spec,
-                             const std::string& rays_dir) {
+                             const std::string& rays_dir, std::vector<std::int32_t>* sources = nullptr) {
   const std::string path = fmt::format("{}/{}.{}.n{}.{:016x}.npy", rays_dir, scene.name, to_string(spec.kind),
                                        spec.count, generator.key(spec));
   std::error_code ec;
-  if (std::filesystem::exists(path, ec)) {
+  if (!sources && std::filesystem::exists(path, ec)) {
     try {
       std::vector<Ray> rays = read_ray_file(path);
       if (rays.size() == spec.count) {
@@ -56,7 +63,7 @@ std::vector<Ray> obtain_rays(const RayGenerator& generator, const Scene& scene, 
     }
   }
   const auto start = std::chrono::steady_clock::now();
-  std::vector<Ray> rays = generator.generate(spec);
+  std::vector<Ray> rays = generator.generate(spec, sources);
   write_ray_file(path, rays);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   progress(fmt::format("  {} rays: generated {} in {:.0f} ms -> {}", to_string(spec.kind), rays.size(), ms, path));
@@ -66,9 +73,7 @@ std::vector<Ray> obtain_rays(const RayGenerator& generator, const Scene& scene, 
 LoadedScene load(const RunOptions& options, const std::string& name_or_path) {
   LoadedScene loaded;
   loaded.entry = options.suite.find(name_or_path);
-  const std::string spec = loaded.entry ? loaded.entry->path : name_or_path;
-  loaded.scene = load_scene(spec);
-  if (loaded.entry) loaded.scene.name = loaded.entry->name;
+  loaded.scene = loaded.entry ? load_suite_scene(*loaded.entry) : load_scene(name_or_path);
   return loaded;
 }
 
@@ -104,6 +109,7 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
   initialize_google_benchmark(
       {fmt::format("--benchmark_enable_random_interleaving={}", options.interleave ? "true" : "false")});
   std::vector<ResultRow> rows;
+  std::vector<AccuracyRow> accuracy_rows;
   for (std::size_t si = 0; si < scenes.size(); ++si) {
     const Scene& scene = scenes[si].scene;
     const SuiteScene* entry = scenes[si].entry;
@@ -122,8 +128,22 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
         }
         RaySetSpec spec{kind, settings.rays, settings.seed, entry ? entry->camera : std::nullopt,
                         entry ? entry->light : std::nullopt, inside};
-        raysets.push_back({kind, obtain_rays(generator, scene, spec, options.rays_dir)});
+        RaySet set{kind, {}, {}, {}};
+        const bool want_sources = !options.accuracy_csv.empty() && has_sources(kind);
+        set.rays = obtain_rays(generator, scene, spec, options.rays_dir, want_sources ? &set.sources : nullptr);
+        raysets.push_back(std::move(set));
       }
+    }
+    std::unique_ptr<Referee> referee;
+    if (!options.accuracy_csv.empty() && !raysets.empty()) {
+      const auto start = std::chrono::steady_clock::now();
+      referee = std::make_unique<Referee>(scene);
+      for (RaySet& rs : raysets) {
+        rs.truth.resize(rs.rays.size());
+        referee->judge(rs.rays, rs.truth);
+      }
+      progress(fmt::format("  referee: judged every ray exactly in {:.0f} ms",
+                           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()));
     }
     if (raysets.empty()) {
       progress(fmt::format("[{}/{}] {}: no ray set applies, scene skipped", si + 1, scenes.size(), scene.name));
@@ -133,6 +153,7 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
     struct Case {
       std::string name;
       ResultRow row;
+      std::optional<AccuracyRow> accuracy;
       const Backend* backend;
       const TraceExecutor* executor;
       const RaySet* rayset;
@@ -184,14 +205,32 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
           row.build_ms_max = *std::max_element(build_ms.begin(), build_ms.end());
           row.memory_bytes = backend->memory_bytes();
           Agreement a;
+          // Accuracy rows are single-run, single thread count: the first one.
+          std::optional<AccuracyRow> accuracy;
+          if (referee && threads == settings.threads.front()) {
+            accuracy.emplace();
+            accuracy->scene = scene.name;
+            if (entry) {
+              accuracy->scale = entry->scale;
+              accuracy->offset_x = entry->offset[0];
+              accuracy->offset_y = entry->offset[1];
+              accuracy->offset_z = entry->offset[2];
+            }
+            accuracy->rayset = row.rayset;
+            accuracy->query = row.query;
+            accuracy->backend = backend_name;
+            accuracy->accuracy_class = backend_accuracy_class(backend_name);
+          }
           if (query_of(rs.kind) == Query::kIntersect) {
             std::vector<Hit> hits(rs.rays.size());
             executor.intersect(*backend, rs.rays, hits);
             a = compare_hits(hits, ref_hits[r]);
+            if (accuracy) judge_hits(*referee, rs.rays, rs.truth, hits, rs.sources, *accuracy);
           } else {
             std::vector<std::uint8_t> occ(rs.rays.size());
             executor.occluded(*backend, rs.rays, occ);
             a = compare_occlusion(occ, ref_occ[r]);
+            if (accuracy) judge_occlusion(rs.rays, rs.truth, occ, *accuracy);
           }
           row.hit_rate = a.hit_rate();
           row.agree_hit = a.agree_hit();
@@ -203,7 +242,7 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
           if (is_must_hit(rs.kind)) row.leaks = a.rays - a.hits;
           const std::string name =
               fmt::format("trace/{}/{}/{}/threads:{}", scene.name, row.rayset, backend_name, threads);
-          cases.push_back({name, row, backend.get(), &executor, &rs});
+          cases.push_back({name, row, accuracy, backend.get(), &executor, &rs});
         }
         backends.push_back(std::move(backend));
       }
@@ -251,6 +290,12 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
       c.row.mrays_s_min = *std::min_element(s.begin(), s.end());
       c.row.mrays_s_max = *std::max_element(s.begin(), s.end());
       rows.push_back(c.row);
+      if (c.accuracy) {
+        c.accuracy->mrays_s = c.row.mrays_s;
+        c.accuracy->mrays_s_min = c.row.mrays_s_min;
+        c.accuracy->mrays_s_max = c.row.mrays_s_max;
+        accuracy_rows.push_back(*c.accuracy);
+      }
     }
   }
 
@@ -282,6 +327,11 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
   });
   write_results_csv(options.out_csv, rows);
   write_metadata(metadata_path_for(options.out_csv), metadata);
+  if (!options.accuracy_csv.empty()) {
+    write_accuracy_csv(options.accuracy_csv, accuracy_rows);
+    write_metadata(metadata_path_for(options.accuracy_csv), metadata);
+    progress(fmt::format("accuracy: {} ({} rows)", options.accuracy_csv, accuracy_rows.size()));
+  }
   return rows;
 }
 

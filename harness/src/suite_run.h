@@ -20,9 +20,14 @@ struct RunOptions {
   bool raysets_from_command_line = false;  // settings.raysets then override each scene's own list
   bool interleave = true;            // interleave repetitions of all cases of a scene
   std::string command_line;          // recorded in the metadata
+  // When set, every ray is also judged by the exact referee and the accuracy
+  // CSV (accuracy/accuracy_csv.h) is written here, with its throughput taken
+  // from this run's timing (the first thread count).
+  std::string accuracy_csv;
 };
 
-// The reference every backend's agreement is measured against.
+// The baseline every backend's agreement and speed ratio are measured
+// against (not the exact referee, which is the backend named "reference").
 inline constexpr const char* kReferenceBackend = "embree";
 
 // Runs the suite and writes the CSV, its .meta.toml and a table on stdout.

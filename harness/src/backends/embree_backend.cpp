@@ -149,7 +149,7 @@ std::vector<BackendInfo> embree_backend_names() {
   return {{"embree", "Embree " RTC_VERSION_STRING ", medium build quality (default), rtcIntersect1/rtcOccluded1"},
           {"embree:high", "Embree, high build quality (spatial splits)"},
           {"embree:low", "Embree, low build quality (fast build)"},
-          {"embree:robust", "Embree with RTC_SCENE_FLAG_ROBUST (options combine: embree:high:robust)"}};
+          {"embree:robust", "Embree with RTC_SCENE_FLAG_ROBUST (options combine: embree:high:robust)", "robust"}};
 }
 
 std::string embree_version() {
