@@ -2,7 +2,10 @@
 #include "rayset.h"
 
 #include <cmath>
+#include <algorithm>
+#include <array>
 #include <cstring>
+#include <set>
 
 #include "error.h"
 #include "raybench/bvh/bvh2_traverse.h"
@@ -49,6 +52,107 @@ INSTANTIATE_TEST_SUITE_P(AllKinds, RaySets,
                          ::testing::Values(RaySetKind::kPrimary, RaySetKind::kDiffuse, RaySetKind::kShadow,
                                            RaySetKind::kUniform),
                          [](const auto& info) { return to_string(info.param); });
+
+// The extreme sets that need no inside ball: deterministic like the others.
+class ExtremeRaySets : public ::testing::TestWithParam<RaySetKind> {};
+
+TEST_P(ExtremeRaySets, AreDeterministicForTheSameSpecAndDifferForAnotherSeed) {
+  const RayGenerator gen(test_scene());
+  const RaySetSpec spec{GetParam(), 2000, 7, std::nullopt, std::nullopt};
+  const std::vector<Ray> a = gen.generate(spec);
+  EXPECT_EQ(a.size(), 2000u);
+  EXPECT_TRUE(identical(a, RayGenerator(test_scene()).generate(spec)));
+  RaySetSpec other = spec;
+  other.seed = 8;
+  EXPECT_FALSE(identical(a, gen.generate(other)));
+}
+
+INSTANTIATE_TEST_SUITE_P(G05toG20, ExtremeRaySets,
+                         ::testing::Values(RaySetKind::kTinyTriangles, RaySetKind::kGrazing, RaySetKind::kDegenerateTriangles,
+                                           RaySetKind::kAxisParallel, RaySetKind::kBehindOrigin, RaySetKind::kInvalid,
+                                           RaySetKind::kDirectionScaling, RaySetKind::kBvhConservative,
+                                           RaySetKind::kReintersection, RaySetKind::kControlRandom, RaySetKind::kFarOrigin),
+                         [](const auto& info) {
+                           std::string name = to_string(info.param);
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
+
+TEST(ExtremeRaySets, AxisParallelRaysHaveSignedZerosAndOriginsOnTheTargetsSlabPlanes) {
+  const Scene boxes = load_scene("proc:axis_boxes");
+  const std::vector<Ray> rays = RayGenerator(boxes).generate({RaySetKind::kAxisParallel, 2600, 1, std::nullopt, std::nullopt});
+  std::size_t negative_zero = 0, positive_zero = 0, patterns = 0;
+  std::set<std::array<int, 3>> seen;
+  for (const Ray& r : rays) {
+    std::array<int, 3> pattern{};
+    for (int a = 0; a < 3; ++a) {
+      pattern[a] = r.dir[a] > 0 ? 1 : r.dir[a] < 0 ? -1 : 0;
+      if (r.dir[a] == 0.0f) (std::signbit(r.dir[a]) ? negative_zero : positive_zero)++;
+      // Along a zero component the origin sits on an integer plane of the grid.
+      if (r.dir[a] == 0.0f) EXPECT_GE(r.org[a], 0.0f);
+    }
+    ASSERT_NE(pattern, (std::array<int, 3>{0, 0, 0}));
+    patterns += seen.insert(pattern).second;
+  }
+  EXPECT_EQ(patterns, 26u);
+  EXPECT_GT(negative_zero, 1000u);
+  EXPECT_GT(positive_zero, 1000u);
+}
+
+TEST(ExtremeRaySets, InvalidRaysCoverEveryCorruptionAndMostAreUntraceable) {
+  const std::vector<Ray> rays = RayGenerator(test_scene()).generate({RaySetKind::kInvalid, 2400, 1, std::nullopt, std::nullopt});
+  std::size_t untraceable = 0, nan_dir = 0, inf_org = 0, empty = 0, zero_dir = 0;
+  for (const Ray& r : rays) {
+    untraceable += !is_traceable(r);
+    nan_dir += std::isnan(r.dir.x) || std::isnan(r.dir.y) || std::isnan(r.dir.z);
+    inf_org += std::isinf(r.org.x) || std::isinf(r.org.y) || std::isinf(r.org.z);
+    empty += r.tnear > r.tfar;
+    zero_dir += r.dir.x == 0 && r.dir.y == 0 && r.dir.z == 0;
+  }
+  EXPECT_EQ(untraceable, 2400u * 21 / 24);  // all but the empty interval and the two zero directions
+  EXPECT_EQ(nan_dir, 300u);
+  EXPECT_EQ(inf_org, 600u);
+  EXPECT_EQ(empty, 100u);
+  EXPECT_EQ(zero_dir, 200u);
+}
+
+TEST(ExtremeRaySets, DirectionScalingCyclesThroughTwentyOrdersOfMagnitudeEachWay) {
+  const std::vector<Ray> rays = RayGenerator(test_scene()).generate({RaySetKind::kDirectionScaling, 10, 1, std::nullopt, std::nullopt});
+  const double expected[5] = {1e-20, 1e-7, 1, 1e7, 1e20};
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const Ray& r = rays[i];
+    const double l = std::sqrt(double(r.dir.x) * r.dir.x + double(r.dir.y) * r.dir.y + double(r.dir.z) * r.dir.z);
+    EXPECT_NEAR(std::log10(l), std::log10(expected[i % 5]), 1e-5) << i;
+  }
+}
+
+TEST(ExtremeRaySets, BehindOriginRaysPointAwayFromTheirTriangle) {
+  // One triangle: every ray starts in front of it and points away, so the
+  // triangle is only at negative t (G14).
+  Scene one;
+  one.name = "one";
+  one.triangles = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}};
+  for (const Ray& r : RayGenerator(one).generate({RaySetKind::kBehindOrigin, 500, 1, std::nullopt, std::nullopt})) {
+    // The plane z = 0 is crossed at t = -oz / dz, which must be negative (or never).
+    if (r.dir.z != 0.0f) EXPECT_LT(-r.org.z / r.dir.z, 0.0f);
+  }
+}
+
+TEST(ExtremeRaySets, SecondaryRaysReportTheTriangleTheyStartFrom) {
+  const RayGenerator gen(test_scene());
+  std::vector<std::int32_t> sources;
+  const std::vector<Ray> rays = gen.generate({RaySetKind::kReintersection, 1000, 1, std::nullopt, std::nullopt}, &sources);
+  ASSERT_EQ(sources.size(), rays.size());
+  EXPECT_TRUE(identical(rays, gen.generate({RaySetKind::kReintersection, 1000, 1, std::nullopt, std::nullopt})));
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    ASSERT_GE(sources[i], 0);
+    // The origin lies on the plane of its source triangle, but for the
+    // offset of a few float spacings of its coordinates (up to ~100 here).
+    const Triangle& t = test_scene().triangles[sources[i]];
+    const Vec3f n = cross(t.v1 - t.v0, t.v2 - t.v0);
+    EXPECT_LT(std::fabs(dot(n, rays[i].org - t.v0)) / length(n), 1e-2f);
+  }
+}
 
 TEST(RaySets, PrimaryRaysStartAtTheNamedCamera) {
   Camera c;

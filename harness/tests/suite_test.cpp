@@ -1,6 +1,8 @@
 // Specification of suite manifests (harness/src/suite.h).
 #include "suite.h"
 
+#include <algorithm>
+
 #include "build_info.h"
 #include "error.h"
 #include "test_util.h"
@@ -60,6 +62,50 @@ TEST(Suite, AClosedSceneDeclaresItsInsideBallAndItsOwnRaySets) {
   EXPECT_TRUE(defaults.find("sphere")->inside.has_value());
 }
 
+TEST(Suite, ASweepMakesOneSceneperScaleAndOffsetThatFloatCanRepresent) {
+  TempDir dir;
+  const auto path = dir.write("s.toml",
+                              "[[scene]]\nname = \"ball\"\npath = \"proc:sphere\"\n"
+                              "inside = { center = [0, 0, 0], radius = 0.5 }\n"
+                              "sweep = { scales = [1e-3, 1.0, 1e4], offsets = [[0, 0, 0], [1e7, 0, 0]] }\n");
+  const Suite s = load_suite(path);
+  // At 1e7 floats are 1 apart: only the 1e4 scale keeps its shape there.
+  std::vector<std::string> names;
+  for (const SuiteScene& e : s.scenes) names.push_back(e.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"ball@s0.001", "ball@s1", "ball@s10000", "ball@s10000@o1e+07_0_0"}));
+  const SuiteScene& far = s.scenes.back();
+  EXPECT_EQ(far.scale, 1e4);
+  EXPECT_EQ(far.offset[0], 1e7);
+  ASSERT_TRUE(far.inside);
+  EXPECT_EQ(far.inside->center.x, 1e7f);
+  EXPECT_EQ(far.inside->radius, 5000.0f);
+  const Scene scene = load_suite_scene(far);
+  EXPECT_EQ(scene.name, far.name);
+  EXPECT_NEAR(scene.bounds().center().x, 1e7f, 1.0f);
+  EXPECT_NEAR(scene.bounds().extent().y, 2e4f, 1.0f);
+}
+
+TEST(Suite, AScaleAndOffsetMoveTheSceneAndItsCamera) {
+  TempDir dir;
+  const auto path = dir.write("s.toml",
+                              "[[scene]]\nname = \"b\"\npath = \"proc:sphere\"\nscale = 2.0\noffset = [10, 0, 0]\n"
+                              "camera = { position = [0, 0, 5], look_at = [0, 0, 0] }\n");
+  const Suite s = load_suite(path);
+  EXPECT_TRUE(s.scenes[0].transformed());
+  EXPECT_EQ(s.scenes[0].camera->position.x, 10.0f);
+  EXPECT_EQ(s.scenes[0].camera->position.z, 10.0f);
+  EXPECT_NEAR(load_suite_scene(s.scenes[0]).bounds().upper.x, 12.0f, 1e-5f);
+}
+
+TEST(Suite, TheAccuracySuiteSweepsFromAMillionthToAMillionUnits) {
+  const Suite s = load_suite(std::string(RAYBENCH_SOURCE_DIR) + "/meshes/accuracy.toml");
+  ASSERT_NE(s.find("sphere@s1e-06"), nullptr);
+  ASSERT_NE(s.find("sphere@s1e+06@o1e+07_1e+07_1e+07"), nullptr);
+  ASSERT_NE(s.find("sphere"), nullptr);
+  EXPECT_NE(std::find(s.settings.backends.begin(), s.settings.backends.end(), "reference"), s.settings.backends.end());
+  EXPECT_NE(std::find(s.settings.backends.begin(), s.settings.backends.end(), "embree:robust"), s.settings.backends.end());
+}
+
 TEST(Suite, MistakesNameTheFileAndTheKey) {
   TempDir dir;
   const struct {
@@ -77,6 +123,9 @@ TEST(Suite, MistakesNameTheFileAndTheKey) {
       {"[[scene]]\nname = \"a\"\npath = \"p\"\ninside = { radius = 1 }\n", "scene[0].inside"},
       {"[[scene]]\nname = \"a\"\npath = \"p\"\nraysets = [\"edge\"]\n", "scene[0].raysets"},
       {"[defaults]\n", "no [[scene]]"},
+      {"[[scene]]\nname = \"a\"\npath = \"p\"\nscale = -1\n", "scene[0].scale"},
+      {"[[scene]]\nname = \"a\"\npath = \"p\"\nsweep = { scales = [] }\n", "scene[0].sweep.scales"},
+      {"[[scene]]\nname = \"a\"\npath = \"p\"\nsweep = { scales = [1.0], offsets = [[1, 2]] }\n", "sweep.offsets"},
   };
   int i = 0;
   for (const auto& c : cases) {
