@@ -1,22 +1,46 @@
-"""Turn a raybench results CSV into a Markdown report with PNG plots.
+"""Turn raybench results and accuracy CSVs into a Markdown report with PNG plots.
 
-    scripts/report RESULTS.csv [--out DIR] [--accuracy ACCURACY.csv] [--title TEXT]
+    scripts/report RESULTS.csv [--out DIR] [--accuracy ACCURACY.csv ...] [--title TEXT]
+    scripts/report --accuracy ACCURACY.csv [--accuracy ACCURACY.csv ...] [--out DIR] [--title TEXT]
 
-Writes DIR/report.md (default DIR: <csv dir>/<csv stem>-report/) and, beside it:
+Writes DIR/report.md (default DIR: <dir>/<stem>-report/ of RESULTS.csv, or of the first
+--accuracy file when there is no RESULTS.csv) and, beside it, from RESULTS.csv:
 
 - throughput-<rayset>[-t<threads>].png: median Mrays/s per scene and backend, min-max whiskers;
 - ratio-<rayset>[-t<threads>].png: each non-Embree backend's ratio_to_embree per scene;
-- pareto-<scene>[-t<threads>].png: speed versus error rate, one panel per ray set, the Pareto
-  front joined by a line. Errors come from --accuracy (false_miss + false_hit + wrong_prim,
-  fractions of rays) or, without it, from the results themselves as 1 - agree_hit, which is
-  disagreement with Embree, not error against a ground truth (on must-hit ray sets, which
+- pareto-<scene>[-t<threads>].png, only without --accuracy: speed versus 1 - agree_hit, which
+  is disagreement with Embree, not error against a ground truth (on must-hit ray sets, which
   have a `leaks` count, leaks / rays, which is).
 
-The report starts with a "Run" section from the sidecar <csv without .csv>.meta.toml when it
-exists, and ends with one table per ray set. Empty CSV fields mean "not applicable" and show "-".
+From each --accuracy file (results/accuracy.csv, results/accuracy-kernels.csv; the schema is
+harness/src/accuracy/accuracy_csv.h; every row is one thread; error = false_miss + false_hit +
+wrong_prim, fractions of rays, shown as %):
 
-Bad input (missing or empty file, missing schema columns, a field that is not a number) prints
-one line `report: error: FILE: problem` on stderr, exits 2 and writes nothing.
+- pareto-<scene>.png: speed (mrays_s) versus error, every backend or kernel variant a point,
+  the Pareto front joined, one panel per ray set. Ray sets that differ only in a parameter
+  suffix (far-small-sphere:D=1e3) share a panel with their rays pooled (rays-weighted error,
+  all rays / total time). Only the scene as given (scale 1, offset 0, or its only transform):
+  rows of the stability sweep are left out;
+- sweep-<scene>.png, for scenes traced at several scales and/or offsets: error rate against
+  scale (log), one line per backend, one panel per ray set and offset (against the offset's
+  distance when only the offset varies), with the numbers as tables and every row of the sweep;
+- parameters-<scene>.png, for ray-set families with a numeric suffix: error rate against the
+  parameter (e.g. D), one line per backend, with the numbers as tables;
+- invalid-rays-<file stem>.png, for scenes with both invalid-rays and control-random ray sets:
+  per backend, time per invalid ray / time per valid ray = mrays_s(control-random) /
+  mrays_s(invalid-rays), with Embree's bar (2.5x) dashed, and a table saying whether each
+  backend stays within it and answers every invalid ray as a miss (false_hit = 0);
+- a table per scene (as given) with every row: rays, error, false miss, false hit, wrong prim,
+  ambiguous, self hits, ulp p50/p99/max, Mrays/s.
+
+The report starts with a "Run" section from the sidecar <csv without .csv>.meta.toml when
+RESULTS.csv has one (an accuracy file's sidecar, if any, is summarised in its own section);
+then the results' plots and one table per ray set; then one section per accuracy file. Empty
+CSV fields mean "not applicable" and show "-".
+
+Bad input (no input at all, a missing or empty file, missing schema columns, a field that is not
+a number, two accuracy rows for the same scene, transform, ray set, query and backend) prints one
+line `report: error: FILE: problem` on stderr, exits 2 and writes nothing.
 """
 import argparse
 import csv
@@ -39,9 +63,17 @@ NUMERIC = ["triangles", "rays", "threads", "build_ms", "build_ms_min", "build_ms
            "memory_bytes", "mrays_s", "mrays_s_min", "mrays_s_max", "reps", "ratio_to_embree",
            "hit_rate", "agree_hit", "agree_prim", "prim_ties", "t_relerr_max", "t_relerr_p999",
            "disagreements", "leaks"]
-ACCURACY_REQUIRED = ["scene", "rayset", "backend", "rays", "false_miss", "false_hit",
-                     "wrong_prim", "mrays_s"]
-ACCURACY_NUMERIC = ["rays", "threads", "false_miss", "false_hit", "wrong_prim", "mrays_s"]
+# The accuracy CSV (harness/src/accuracy/accuracy_csv.h): every column is required, as raybench's
+# own reader requires them. Rates are fractions of the row's rays; empty = not applicable.
+ACCURACY_COLUMNS = ["scene", "scale", "offset_x", "offset_y", "offset_z", "rayset", "query",
+                    "backend", "accuracy_class", "rays", "invalid", "truth_hits", "ambiguous",
+                    "false_miss", "false_hit", "wrong_prim", "self_hits", "ulp_p50", "ulp_p99",
+                    "ulp_max", "mrays_s", "mrays_s_min", "mrays_s_max"]
+ACCURACY_NUMERIC = [c for c in ACCURACY_COLUMNS
+                    if c not in ("scene", "rayset", "query", "backend", "accuracy_class")]
+IDENTITY = (1.0, 0.0, 0.0, 0.0)  # (scale, offset_x, offset_y, offset_z): the scene as given
+INVALID_RAYSET, CONTROL_RAYSET = "invalid-rays", "control-random"
+INVALID_BAR = 2.5  # Embree's bar: an invalid ray costs at most 2.5x a valid one
 
 DASH = "\u2013"  # en dash: the "not applicable" mark and the min-max separator
 DPI = 110
@@ -58,8 +90,9 @@ class InputError(Exception):
 # Reading
 
 
-def read_table(path, required, numeric):
-    """Rows of a CSV as dicts, numeric fields as float (None when empty); InputError if bad."""
+def read_table(path, required, numeric, check=None):
+    """Rows of a CSV as dicts, numeric fields as float (None when empty); InputError if bad.
+    check(line, row), when given, validates one parsed row further (it knows the line)."""
     try:
         with open(path, newline="", encoding="utf-8-sig") as f:
             text = f.read()
@@ -84,7 +117,10 @@ def read_table(path, required, numeric):
         line = reader.line_num
         if None in row or None in row.values():
             raise InputError(path, f"line {line}: expected {len(header)} fields")
-        rows.append(parse_row(path, line, row, numeric))
+        parsed = parse_row(path, line, row, numeric)
+        if check:
+            check(line, parsed)
+        rows.append(parsed)
     if not rows:
         raise InputError(path, "no data rows (header only)")
     return rows
@@ -114,6 +150,40 @@ def parse_row(path, line, row, numeric):
         if not parsed.get(key):
             raise InputError(path, f"line {line}: column {key} is empty")
     return parsed
+
+
+class AccuracyFile:
+    """One --accuracy file: its path, its rows and its sidecar metadata ({} when absent)."""
+
+    def __init__(self, path, rows, meta):
+        self.path, self.rows, self.meta = path, rows, meta
+        self.name = os.path.basename(path)
+        self.stem = os.path.splitext(self.name)[0]
+
+
+def read_accuracy(path):
+    """An accuracy CSV. Beyond the schema: scale, offsets and rays must be given (rays a whole
+    number), and no two rows may share scene, transform, ray set, query and backend, since
+    every plot would silently pick one of them."""
+    first_line = {}
+
+    def check(line, row):
+        for key in ("scale", "offset_x", "offset_y", "offset_z", "rays"):
+            if row[key] is None:
+                raise InputError(path, f"line {line}: column {key} is empty")
+        if not row["rays"].is_integer() or row["rays"] < 0:
+            raise InputError(path, f"line {line}: column rays: not a whole number: "
+                                   f"{row['rays']!r}")
+        row["rays"] = int(row["rays"])
+        row["transform"] = (row["scale"], row["offset_x"], row["offset_y"], row["offset_z"])
+        key = (row["scene"], row["transform"], row["rayset"], row["query"], row["backend"])
+        if key in first_line:
+            raise InputError(path, f"line {line}: same scene, scale, offset, rayset, query and "
+                                   f"backend as line {first_line[key]}")
+        first_line[key] = line
+
+    rows = read_table(path, ACCURACY_COLUMNS, ACCURACY_NUMERIC, check)
+    return AccuracyFile(path, rows, read_meta(path))
 
 
 def meta_path(csv_path):
@@ -184,6 +254,51 @@ def fmt_percent(value):
     if value is None:
         return DASH
     return fmt_fraction(value * 100, 4) + " %"
+
+
+def fmt_rate(value):
+    """A fraction of rays as a percentage: "0" only when exactly zero (one wrong ray in a
+    million must not read as 0 %), three significant digits, never a rounded-up "100 %"."""
+    if value is None or math.isnan(value):
+        return DASH
+    if value == 0:
+        return "0"
+    return fmt_fraction(value * 100, 3).replace("e-0", "e-") + " %"
+
+
+def fmt_ulp(value):
+    """ulp distances: small ones as they are, huge ones (a wrong t) in exponent form."""
+    if value is None or math.isnan(value):
+        return DASH
+    return fmt_short(value) if abs(value) >= 1e5 else fmt_sig(value)
+
+
+def fmt_short(value):
+    """1e-06 -> 1e-6, 1000 -> 1e3, 148376 -> 148376: scales, offsets and ray-set parameters
+    (round numbers from 1000 and up to 0.001 in exponent form, others in full up to 1e6)."""
+    if value is None or math.isnan(value):
+        return DASH
+    round_number = float(f"{value:.2g}") == value and not 1e-3 < abs(value) < 1e3
+    if value != 0 and (abs(value) >= 1e6 or abs(value) < 1e-3 or round_number):
+        mantissa, exponent = f"{value:.2e}".split("e")
+        return f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"
+    return f"{value:.6g}"
+
+
+def fmt_offset(transform):
+    _, *offset = transform
+    return "0" if not any(offset) else "(" + ", ".join(fmt_short(v) for v in offset) + ")"
+
+
+def offset_text(row):
+    return fmt_offset(row["transform"])
+
+
+def fmt_transform(transform):
+    """"scale 1e3, offset (148376, 1234, -223423)" -- "as given" for the identity."""
+    if transform == IDENTITY:
+        return "as given"
+    return f"scale {fmt_short(transform[0])}, offset {fmt_offset(transform)}"
 
 
 def fmt_throughput(row):
@@ -416,7 +531,6 @@ def plot_pareto(path, panels, colors, title, notes):
 def draw_pareto_panel(ax, rayset, points, colors):
     errors = [p["error"] for p in points]
     rays = max((p["rays"] or 0 for p in points), default=0)
-    threshold = symlog_threshold(errors, rays)
     front = pareto_front(points)
     ax.plot([p["error"] for p in front], [p["speed"] for p in front], color="grey",
             linestyle="--", linewidth=1.2, zorder=1, label="Pareto front")
@@ -426,8 +540,7 @@ def draw_pareto_panel(ax, rayset, points, colors):
         ax.scatter([p["error"]], [p["speed"]], s=42, zorder=3, linewidths=1.5,
                    color=colors[p["backend"]] if filled else "white",
                    edgecolors=colors[p["backend"]])
-    ax.set_xscale("symlog", linthresh=threshold, linscale=0.6)
-    ax.set_xlim(-0.6 * threshold, max(max(errors) * 4, threshold * 100))
+    error_axis(ax, "x", errors, rays, percent=points[0]["kind"] == "accuracy")
     speeds = [p["speed"] for p in points]
     if wide_range(speeds, 10):
         log_axis(ax)
@@ -473,15 +586,244 @@ def annotate_points(ax, points):
 
 
 # ---------------------------------------------------------------------------------------------
+# Accuracy rows: what belongs together
+
+
+def error_rate(row):
+    """false_miss + false_hit + wrong_prim, the fraction of rays answered wrongly; the parts
+    that do not apply (empty) count 0, and a row where none applies has no error rate."""
+    parts = [row[k] for k in ("false_miss", "false_hit", "wrong_prim") if row[k] is not None]
+    return sum(parts) if parts else None
+
+
+PARAMETER = re.compile(r"^(?P<family>.+):(?P<name>[A-Za-z_][A-Za-z0-9_]*)=(?P<value>[^:=]+)$")
+
+
+def rayset_parameter(rayset):
+    """("far-small-sphere", "D", 1000.0) for "far-small-sphere:D=1e3": ray sets that differ
+    only in such a suffix are one family, plotted against the parameter; (rayset, None, None)
+    when there is no numeric suffix."""
+    match = PARAMETER.match(rayset)
+    if match:
+        try:
+            return match["family"], match["name"], float(match["value"])
+        except ValueError:
+            pass
+    return rayset, None, None
+
+
+def parameter_texts(rows):
+    """Parameter value -> its text as written in the ray-set names ("1e2", not "100")."""
+    return {rayset_parameter(r["rayset"])[2]: r["rayset"].rsplit("=", 1)[1] for r in rows
+            if rayset_parameter(r["rayset"])[1]}
+
+
+def rayset_label(rayset, query):
+    """A ray set (or family) as a panel title: occlusion queries marked, closest hit implied."""
+    return rayset + (" (any hit)" if query == "occluded" else "")
+
+
+def family_label(row):
+    return rayset_label(rayset_parameter(row["rayset"])[0], row["query"])
+
+
+def pooled(rows, value_of):
+    """A rate over several rows on disjoint rays: the rays-weighted mean (None if any is
+    missing). One row: its own value, even when it has no rays."""
+    values = [value_of(r) for r in rows]
+    if any(v is None for v in values):
+        return None
+    if len(rows) == 1:
+        return values[0]
+    rays = sum(r["rays"] for r in rows)
+    return sum(v * r["rays"] for v, r in zip(values, rows)) / rays if rays else None
+
+
+def pooled_speed(rows):
+    """Mrays/s over several rows: all rays / total time (None unless every row was timed)."""
+    if len(rows) == 1:
+        return rows[0]["mrays_s"]
+    if any(not r["mrays_s"] or r["mrays_s"] <= 0 for r in rows):
+        return None
+    rays = sum(r["rays"] for r in rows)
+    return rays / sum(r["rays"] / r["mrays_s"] for r in rows) if rays else None
+
+
+def pooled_words(family):
+    """", D=1e2..1e10 pooled" for a family of parametrised ray sets; "" for a single ray set."""
+    values = sorted({rayset_parameter(r["rayset"])[2] for r in family} - {None})
+    if len(ordered(r["rayset"] for r in family)) < 2 or not values:
+        return ""
+    name, texts = rayset_parameter(family[0]["rayset"])[1], parameter_texts(family)
+    return f", {name}={texts[values[0]]}..{texts[values[-1]]} pooled"
+
+
+def by_scene_transform(rows):
+    """scene -> {transform -> rows}, in file order."""
+    scenes = {}
+    for r in rows:
+        scenes.setdefault(r["scene"], {}).setdefault(r["transform"], []).append(r)
+    return scenes
+
+
+def base_transform(transforms):
+    """The transform a scene's Pareto plot and main table show: the scene as given (scale 1,
+    offset 0), or its only transform; None for a sweep without the untransformed scene."""
+    if IDENTITY in transforms:
+        return IDENTITY
+    return next(iter(transforms)) if len(transforms) == 1 else None
+
+
+def group_by(rows, key):
+    """key(row) -> rows, in order of first appearance."""
+    groups = {}
+    for r in rows:
+        groups.setdefault(key(r), []).append(r)
+    return groups
+
+
+# ---------------------------------------------------------------------------------------------
+# Accuracy plots
+
+
+def percent_formatter():
+    from matplotlib.ticker import FuncFormatter
+    return FuncFormatter(
+        lambda v, _: "0" if v == 0 else re.sub(r"e([+-])0*(\d)", r"e\1\2", f"{v * 100:.6g}")
+        .replace("e+", "e") + " %")
+
+
+def error_axis(ax, which, errors, rays, percent):
+    """A symlog error axis: linear below one ray's worth, where the many exact zeros sit,
+    logarithmic above, so 0.001 % and 10 % are both readable."""
+    threshold = symlog_threshold(errors, rays)
+    top = min(max(max(errors, default=0.0) * 4, threshold * 100), 2.0 if percent else math.inf)
+    if which == "x":
+        ax.set_xscale("symlog", linthresh=threshold, linscale=0.6)
+        ax.set_xlim(-0.6 * threshold, top)
+    else:
+        ax.set_yscale("symlog", linthresh=threshold, linscale=0.6)
+        ax.set_ylim(-0.6 * threshold, top)
+    if percent:
+        (ax.xaxis if which == "x" else ax.yaxis).set_major_formatter(percent_formatter())
+
+
+def number_axis(ax, values):
+    """The x axis of an error-against-a-number plot: log when every value is positive and
+    they span decades (scales 1e-6..1e6, distances 1e2..1e10), symlog when 0 is among them
+    (an offset of 0), linear otherwise."""
+    from matplotlib.ticker import FuncFormatter
+    positive = [v for v in values if v > 0]
+    if positive and len(positive) == len(values) and wide_range(values, 8):
+        ax.set_xscale("log")
+    elif positive and any(v == 0 for v in values) and wide_range(positive, 8):
+        ax.set_xscale("symlog", linthresh=min(positive), linscale=0.6)
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: fmt_short(v)))
+
+
+MARKERS = "osD^vP<>X*h"
+
+
+def plot_error_lines(path, panels, ncols, colors, title):
+    """Error rate against a number, one line per backend: how each kernel degrades as the
+    scene is scaled or moved away from the origin, or as a ray-set parameter grows.
+    panels: [(panel title, x label, {backend: [(x, error, rays)]})]. Backends at the same
+    error overlap, so each has its own marker as well as its colour."""
+    plt = pyplot()
+    from matplotlib.lines import Line2D
+    nrows = math.ceil(len(panels) / ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(4.2 * ncols + 2.2, 3.3 * nrows + 0.9),
+                             layout="constrained", squeeze=False)
+    for ax in axes.flat[len(panels):]:
+        ax.set_visible(False)
+    backends = ordered(b for _, _, series in panels for b in series)
+    marker = {b: MARKERS[i % len(MARKERS)] for i, b in enumerate(backends)}
+    for ax, (name, x_label, series) in zip(axes.flat, panels):
+        xs_all, errors, rays = [], [], 0
+        for backend, points in series.items():
+            points = sorted(points)
+            xs, ys = [p[0] for p in points], [p[1] for p in points]
+            ax.plot(xs, ys, marker=marker[backend], markersize=4.5, linewidth=1.2, alpha=0.85,
+                    color=colors[backend], markerfacecolor="none", markeredgewidth=1.2)
+            xs_all += xs
+            errors += ys
+            rays = max([rays] + [p[2] or 0 for p in points])
+        number_axis(ax, xs_all)
+        error_axis(ax, "y", errors, rays, percent=True)
+        ax.set_title(name)
+        ax.set_xlabel(x_label)
+        ax.set_ylabel("error rate (% of rays, symlog)")
+        ax.grid(alpha=0.3)
+    # Lines at the same error hide each other: the legend says how high each one gets.
+    worst = {b: max(p[1] for _, _, series in panels for p in series.get(b, [])) for b in backends}
+    handles = [Line2D([], [], color=colors[b], marker=marker[b], markerfacecolor="none",
+                      label=f"{b} (max {fmt_rate(worst[b])})") for b in backends]
+    axes.flat[min(ncols, len(panels)) - 1].legend(handles=handles, title="backend (max error)",
+                                                   loc="upper left", bbox_to_anchor=(1.02, 1.0),
+                                                   frameon=False)
+    fig.suptitle(wrap_title(title, fig))
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+
+
+def plot_invalid_rays(path, costs, colors, title):
+    """Bars of the cost of an invalid ray relative to a valid one, grouped by scene, with
+    Embree's bar (2.5x) dashed: NaN/Inf screening must be cheap, and must not turn into a
+    full traversal. Hatched bars: the backend answered a hit for some invalid ray."""
+    plt = pyplot()
+    from matplotlib.patches import Patch
+    groups = ordered(c["group"] for c in costs)
+    backends = ordered(c["backend"] for c in costs)
+    by_key = {(c["group"], c["backend"]): c for c in costs}
+
+    def value_of(group, backend):
+        cost = by_key.get((group, backend))
+        return None if cost is None else (cost["slowdown"], None, None)
+
+    fig, ax = plt.subplots(figsize=(figure_width(groups, len(backends)), 4.8),
+                           layout="constrained")
+    draw_grouped_bars(ax, groups, backends, colors, value_of, whiskers=False)
+    bars = [c for c in ax.containers if hasattr(c, "patches")]
+    for backend, container in zip(backends, bars):
+        present = [g for g in groups if (g, backend) in by_key]
+        for group, patch in zip(present, container.patches):
+            if by_key[(group, backend)]["false_hit"]:
+                patch.set_hatch("////")
+                patch.set_edgecolor("black")
+    ax.axhline(INVALID_BAR, color="black", linewidth=1.2, linestyle="--", zorder=4,
+               label=f"Embree's bar: {INVALID_BAR:g}\u00d7 a valid ray")
+    values = [c["slowdown"] for c in costs] + [INVALID_BAR]
+    if wide_range(values, 20):
+        log_axis(ax)
+        ax.set_ylabel("time per invalid ray / per valid ray (log scale)")
+    else:
+        ax.set_ylim(0, max(values) * 1.15)
+        ax.set_ylabel("time per invalid ray / per valid ray (\u00d7)")
+    if len(backends) <= 4:
+        label_bars(ax)
+    ax.set_xticklabels(groups)
+    rotate_if_crowded(ax, fig, groups)
+    ax.set_title(wrap_title(title, fig))
+    handles, _ = ax.get_legend_handles_labels()
+    if any(c["false_hit"] for c in costs):
+        handles.append(Patch(facecolor="white", edgecolor="black", hatch="////",
+                             label="hit an invalid ray"))
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.0, 1.0), frameon=False)
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+
+
+# ---------------------------------------------------------------------------------------------
 # What to plot
 
 
 class Plot:
     """One PNG: where it goes in the report and how to draw it."""
 
-    def __init__(self, section, heading, sentence, filename, draw):
+    def __init__(self, section, heading, sentence, filename, draw, extra=()):
         self.section, self.heading, self.sentence = section, heading, sentence
         self.filename, self.draw = filename, draw
+        self.extra = list(extra)  # Markdown lines after the image (a table of its numbers)
 
 
 def rayset_caption(rows, rayset):
@@ -546,30 +888,15 @@ def ratio_plots(rows, scenes, backends, raysets, all_threads, colors, triangles)
 
 # What a point's error means, by where it came from: the x-axis label and the figure's note.
 ERROR_KINDS = {
-    "accuracy": ("error rate (fraction of rays, symlog)",
-                 "error = false miss + false hit + wrong triangle, as fractions of rays "
-                 "(from the accuracy file)"),
+    "accuracy": ("error rate (% of rays, symlog)",
+                 "error = false miss + false hit + wrong triangle, % of rays "
+                 "(from the accuracy file, judged by the exact referee)"),
     "disagree": ("1 \u2212 agree_hit: disagreement with Embree (symlog)",
                  "error = 1 \u2212 agree_hit: hit/miss DISAGREEMENT WITH EMBREE "
                  "(not ground truth; Embree is 0 by definition)"),
     "leaks": ("leaked rays / rays (every ray must hit; symlog)",
               "must-hit ray sets: error = leaks / rays, ground truth (every ray must hit)"),
 }
-
-
-def error_points_from_accuracy(accuracy):
-    """(scene, rayset, threads) -> points, error = false_miss + false_hit + wrong_prim."""
-    groups = {}
-    for r in accuracy:
-        if r["mrays_s"] is None:
-            continue
-        parts = [r[k] for k in ("false_miss", "false_hit", "wrong_prim") if r[k] is not None]
-        if not parts:
-            continue
-        point = {"backend": r["backend"], "error": sum(parts), "speed": r["mrays_s"],
-                 "rays": r["rays"], "kind": "accuracy"}
-        groups.setdefault((r["scene"], r["rayset"], r.get("threads")), []).append(point)
-    return groups
 
 
 def error_points_from_results(rows):
@@ -593,9 +920,7 @@ def error_points_from_results(rows):
 
 
 def pareto_sentence(kinds):
-    if "accuracy" in kinds:
-        error = "more rays answered wrongly"
-    elif kinds == {"leaks"}:
+    if kinds == {"leaks"}:
         error = "more rays leaked through a closed mesh"
     else:
         error = ("more rays on which it disagrees with Embree about hit or miss (not an error "
@@ -607,12 +932,14 @@ def pareto_sentence(kinds):
             "error), drawn as filled points.")
 
 
-def pareto_plots(groups, raysets, colors, triangles):
+def pareto_plots(groups, raysets, colors, triangles, used):
+    """Speed versus error from a results file alone (no --accuracy): see
+    error_points_from_results for what the error is."""
     scenes = ordered(key[0] for key in groups)
     raysets = [rs for rs in raysets if any(k[1] == rs for k in groups)] + \
         ordered(k[1] for k in groups if k[1] not in raysets)
     all_threads = sorted(ordered(k[2] for k in groups), key=lambda t: (t is None, t or 0))
-    plots, used = [], set()
+    plots = []
     for scene in scenes:
         for threads in all_threads:
             panels = [(rs, groups[(scene, rs, threads)]) for rs in raysets
@@ -641,6 +968,335 @@ def unique_name(stem, used):
         name = f"{stem}-{n}.png"
     used.add(name)
     return name
+
+
+# ---------------------------------------------------------------------------------------------
+# One accuracy file: what to plot, and its part of the report
+
+
+ACCURACY_HEADER = ["ray set", "backend", "class", "rays", "error", "false miss", "false hit",
+                   "wrong prim", "ambiguous", "self hits", "ulp p50", "ulp p99", "ulp max",
+                   "Mrays/s"]
+
+
+def accuracy_cells(row):
+    return [md_escape(rayset_label(row["rayset"], row["query"])), md_escape(row["backend"]),
+            md_escape(row["accuracy_class"]) or DASH, f"{row['rays']:,}",
+            fmt_rate(error_rate(row)), fmt_rate(row["false_miss"]), fmt_rate(row["false_hit"]),
+            fmt_rate(row["wrong_prim"]), fmt_rate(row["ambiguous"]), fmt_rate(row["self_hits"]),
+            fmt_ulp(row["ulp_p50"]), fmt_ulp(row["ulp_p99"]), fmt_ulp(row["ulp_max"]),
+            fmt_sig(row["mrays_s"])]
+
+
+def md_table(header, rows, text_columns):
+    """A Markdown table, the first `text_columns` columns left-aligned, numbers right."""
+    return (["| " + " | ".join(header) + " |",
+             "|" + "|".join("---" if i < text_columns else "---:"
+                            for i in range(len(header))) + "|"]
+            + ["| " + " | ".join(cells) + " |" for cells in rows] + [""])
+
+
+def accuracy_table(rows, with_transform=False):
+    """Every row, by ray set then backend (file order): the numbers behind the plots."""
+    raysets = ordered(r["rayset"] for r in rows)
+    backends = ordered(r["backend"] for r in rows)
+    transforms = ordered(r["transform"] for r in rows)
+    rows = sorted(rows, key=lambda r: (transforms.index(r["transform"]),
+                                       raysets.index(r["rayset"]), backends.index(r["backend"])))
+    header = (["scale", "offset"] if with_transform else []) + ACCURACY_HEADER
+    cells = [([fmt_short(r["scale"]), fmt_offset(r["transform"])] if with_transform else [])
+             + accuracy_cells(r) for r in rows]
+    return md_table(header, cells, 5 if with_transform else 3)
+
+
+def image_lines(heading, filename, level):
+    return [f"{'#' * level} {heading}", "", f"![{heading}]({filename})", ""]
+
+
+def scene_pareto_panels(rows):
+    """scene -> (base transform, [(panel title, [point])]) for the speed-versus-error plots:
+    only the scene as given (its base transform; the sweep's other scales and offsets would
+    mix different geometry into one point), one panel per ray-set family and query, each
+    backend's rows in a family pooled (rays-weighted error, all rays / total time). Rows
+    without a throughput have no place on the speed axis and are left out."""
+    scenes = {}
+    for scene, transforms in by_scene_transform(rows).items():
+        base = base_transform(transforms)
+        if base is None:
+            continue
+        panels = []
+        for label, family in group_by(transforms[base], family_label).items():
+            label += pooled_words(family)
+            points = []
+            for backend, group in group_by(family, lambda r: r["backend"]).items():
+                error, speed = pooled(group, error_rate), pooled_speed(group)
+                if error is not None and speed is not None:
+                    points.append({"backend": backend, "error": error, "speed": speed,
+                                   "rays": sum(r["rays"] for r in group), "kind": "accuracy"})
+            if points:
+                panels.append((label, points))
+        if panels:
+            scenes[scene] = (base, panels)
+    return scenes
+
+
+def accuracy_pareto_plots(acc, colors, used):
+    """One speed-versus-error figure per scene of an accuracy file."""
+    plots = []
+    for scene, (base, panels) in scene_pareto_panels(acc.rows).items():
+        heading = scene + ("" if base == IDENTITY else f" ({fmt_transform(base)})")
+        title = f"Speed versus error: {heading} ({acc.name}, 1 thread)"
+        notes = [ERROR_KINDS["accuracy"][1]]
+        plots.append(Plot("Speed versus error", heading, None,
+                          unique_name(f"pareto-{safe_name(scene)}", used),
+                          lambda path, p=panels, t=title, n=notes: plot_pareto(
+                              path, p, colors, t, n)))
+    return plots
+
+
+def error_series(rows, x_of):
+    """{backend: [(x, error, rays)]} with each backend's rows at the same x pooled."""
+    series = {}
+    for (backend, x), group in group_by(rows, lambda r: (r["backend"], x_of(r))).items():
+        error = pooled(group, error_rate)
+        if error is not None:
+            series.setdefault(backend, []).append((x, error, sum(r["rays"] for r in group)))
+    return series
+
+
+def pivot_table(series, x_text, row_header="backend"):
+    """The lines of a plot as a table: one row per line, one column per x, error rates."""
+    xs = sorted({x for points in series.values() for x, _, _ in points})
+    cells = []
+    for name, points in series.items():
+        at = {x: error for x, error, _ in points}
+        cells.append([md_escape(name)] + [fmt_rate(at.get(x)) for x in xs])
+    return md_table([row_header] + [x_text(x) for x in xs], cells, 1)
+
+
+def stability_plots(acc, colors, used):
+    """Scenes traced at several scales and/or offsets (the stability sweep): error rate
+    against scale, one line per backend, one panel per (ray-set family, offset); a sweep of
+    offsets alone is plotted against the offset's distance from the origin instead. Only ray
+    sets traced at two transforms or more have a panel (the untransformed scene is the point
+    at scale 1, offset 0); the table under the plot lists their rows, and every row of the
+    scene at another transform than the one "Results by scene" shows."""
+    plots = []
+    for scene, transforms in by_scene_transform(acc.rows).items():
+        if len(transforms) < 2:
+            continue
+        base = base_transform(transforms)
+        everything = [r for group in transforms.values() for r in group]
+        families = group_by(everything, family_label)
+        swept = {label for label, family in families.items()
+                 if len({r["transform"] for r in family}) > 1}
+        rows = [r for r in everything if family_label(r) in swept]
+        listed = [r for r in everything if family_label(r) in swept or r["transform"] != base]
+        scales = {r["scale"] for r in rows}
+        panels, tables = [], []
+        for label, family in group_by(rows, family_label).items():
+            if len(scales) > 1:
+                offsets = group_by(family, offset_text)
+                for offset, at_offset in offsets.items():
+                    series = error_series(at_offset, lambda r: r["scale"])
+                    if series:
+                        panels.append((f"{label}, offset {offset}", "scale", series))
+                tables += [f"{label}: error rate by scale", ""]
+                series = {}
+                for offset, at_offset in offsets.items():
+                    for backend, points in error_series(at_offset, lambda r: r["scale"]).items():
+                        series[f"{backend} at {offset}" if len(offsets) > 1 else backend] = points
+                tables += pivot_table(series, lambda v: f"scale {fmt_short(v)}",
+                                      "backend at offset" if len(offsets) > 1 else "backend")
+            else:
+                distance = lambda r: math.hypot(r["offset_x"], r["offset_y"], r["offset_z"])
+                series = error_series(family, distance)
+                if series:
+                    panels.append((label, "offset distance from the origin", series))
+                tables += [f"{label}: error rate by offset distance", ""]
+                tables += pivot_table(series, lambda v: f"|offset| {fmt_short(v)}")
+        if not panels:
+            continue
+        ncols = min(4, len(group_by(rows, offset_text)) if len(scales) > 1 else 3, len(panels))
+        title = (f"Stability sweep: {scene} ({acc.name}), error rate against "
+                 + ("scale" if len(scales) > 1 else "offset") + ", one line per backend")
+        details = ["<details><summary>" + f"{len(listed):,} rows of the sweep</summary>", ""]
+        details += accuracy_table(listed, with_transform=True) + ["</details>", ""]
+        plots.append(Plot("Stability under scale and offset", scene, None,
+                          unique_name(f"sweep-{safe_name(scene)}", used),
+                          lambda path, p=panels, n=ncols, t=title: plot_error_lines(
+                              path, p, n, colors, t),
+                          extra=tables + details))
+    return plots
+
+
+def parameter_plots(acc, colors, used):
+    """Ray sets that differ only in a numeric suffix (far-small-sphere:D=1e2 ... D=1e10):
+    error rate against the parameter, one line per backend, one panel per family. This is
+    where a kernel's breakdown point shows (EXTREMES G12: the error rate against D)."""
+    plots = []
+    for scene, transforms in by_scene_transform(acc.rows).items():
+        base = base_transform(transforms)
+        if base is None:
+            continue
+        panels, tables = [], []
+        parametrised = [r for r in transforms[base] if rayset_parameter(r["rayset"])[1]]
+        for label, family in group_by(parametrised, family_label).items():
+            names = ordered(rayset_parameter(r["rayset"])[1] for r in family)
+            values = {rayset_parameter(r["rayset"])[2] for r in family}
+            if len(names) != 1 or len(values) < 2:
+                continue
+            series = error_series(family, lambda r: rayset_parameter(r["rayset"])[2])
+            panels.append((label, names[0], series))
+            tables += [f"{label}: error rate by {names[0]}", ""]
+            texts = parameter_texts(family)
+            tables += pivot_table(series, lambda v, n=names[0], t=texts: f"{n}={t[v]}")
+        if not panels:
+            continue
+        heading = scene + ("" if base == IDENTITY else f" ({fmt_transform(base)})")
+        title = (f"Error rate against the ray-set parameter: {heading} ({acc.name}), "
+                 "one line per backend")
+        plots.append(Plot("Error against a ray-set parameter", heading, None,
+                          unique_name(f"parameters-{safe_name(scene)}", used),
+                          lambda path, p=panels, t=title: plot_error_lines(
+                              path, p, min(3, len(p)), colors, t),
+                          extra=tables))
+    return plots
+
+
+def invalid_ray_costs(acc):
+    """Per scene (as given) with both an invalid-rays and a control-random ray set, per backend
+    timed on both: time per invalid ray / time per valid ray = mrays_s(control) /
+    mrays_s(invalid), and false_hit on the invalid rays (the truth for them is a miss)."""
+    costs = []
+    for scene, transforms in by_scene_transform(acc.rows).items():
+        base = base_transform(transforms)
+        if base is None:
+            continue
+        families = group_by(transforms[base], lambda r: (rayset_parameter(r["rayset"])[0],
+                                                         r["query"]))
+        queries = ordered(q for (_, q) in families)
+        for query in queries:
+            invalid = group_by(families.get((INVALID_RAYSET, query), []), lambda r: r["backend"])
+            control = group_by(families.get((CONTROL_RAYSET, query), []), lambda r: r["backend"])
+            for backend in (b for b in invalid if b in control):
+                invalid_speed = pooled_speed(invalid[backend])
+                control_speed = pooled_speed(control[backend])
+                if not invalid_speed or not control_speed:
+                    continue
+                costs.append({"group": rayset_label(scene, query) if len(queries) > 1 else scene,
+                              "backend": backend, "control_speed": control_speed,
+                              "invalid_speed": invalid_speed,
+                              "slowdown": control_speed / invalid_speed,
+                              "false_hit": pooled(invalid[backend], lambda r: r["false_hit"])})
+    return costs
+
+
+def invalid_rays_table(costs):
+    """The bars as a table, with the two verdicts spelled out: within Embree's 2.5x bar, and
+    every invalid ray answered as a miss."""
+    cells = []
+    for c in costs:
+        within = "yes" if c["slowdown"] <= INVALID_BAR else "**no**"
+        if c["false_hit"] is None:
+            missed = DASH
+        else:
+            missed = "yes" if c["false_hit"] == 0 else f"**no**: {fmt_rate(c['false_hit'])} hit"
+        cells.append([md_escape(c["group"]), md_escape(c["backend"]),
+                      fmt_sig(c["control_speed"]), fmt_sig(c["invalid_speed"]),
+                      fmt_sig(c["slowdown"]) + "\u00d7", within, missed])
+    header = ["scene", "backend", f"{CONTROL_RAYSET} Mrays/s", f"{INVALID_RAYSET} Mrays/s",
+              "invalid / valid time", f"\u2264 {INVALID_BAR:g}\u00d7", "all invalid rays missed"]
+    return md_table(header, cells, 2)
+
+
+def invalid_rays_plot(acc, colors, used):
+    costs = invalid_ray_costs(acc)
+    if not costs:
+        return None
+    title = (f"Cost of an invalid ray ({acc.name}, 1 thread)\ntime per {INVALID_RAYSET} ray / "
+             f"time per {CONTROL_RAYSET} ray; hatched: answered a hit for some invalid ray")
+    return Plot("Invalid rays", "Invalid rays", None,
+                unique_name(f"invalid-rays-{safe_name(acc.stem)}", used),
+                lambda path, c=costs, t=title: plot_invalid_rays(path, c, colors, t),
+                extra=invalid_rays_table(costs))
+
+
+SECTION_INTROS = {
+    "Speed versus error": (
+        "One figure per scene, one panel per ray set; each point is a backend or kernel "
+        "variant: further right = more rays answered wrongly (false miss + false hit + wrong "
+        "triangle, % of rays, symlog so that 0 has a place), higher = faster (Mrays/s, one "
+        "thread). The dashed line joins the Pareto front (filled points: no other backend is "
+        "both faster and more accurate). Ray sets that differ only in a parameter suffix "
+        "(`far-small-sphere:D=1e3`) share a panel: their rays pooled, error = wrong rays / all "
+        "rays, speed = all rays / total time. Only the scene as given (scale 1, offset 0); the "
+        "stability sweep's scaled and moved copies are plotted separately. Rows without a "
+        "throughput are left out."),
+    "Stability under scale and offset": (
+        "Scenes traced at several scales and offsets (every vertex v becomes "
+        "float(scale \u00b7 v + offset)): error rate against scale, one line per backend, one "
+        "panel per ray set and offset. A line that rises at large scale or offset is a "
+        "kernel that is not scale-invariant (absolute epsilons, lost precision far from "
+        "the origin)."),
+    "Error against a ray-set parameter": (
+        "Ray sets that differ only in a numeric suffix (`far-small-sphere:D=1e3`): error rate "
+        "against that parameter, one line per backend, one panel per ray-set family."),
+    "Invalid rays": (
+        f"Per scene with both `{INVALID_RAYSET}` and `{CONTROL_RAYSET}` ray sets: each backend's "
+        f"time per invalid ray relative to a valid one, mrays_s({CONTROL_RAYSET}) / "
+        f"mrays_s({INVALID_RAYSET}). Embree's bar is at most {INVALID_BAR:g}\u00d7 (dashed); "
+        "every invalid ray must be answered as a miss (false hit = 0)."),
+}
+
+
+def accuracy_summary(acc):
+    rows = acc.rows
+    scenes = ordered(r["scene"] for r in rows)
+    backends = ordered(r["backend"] for r in rows)
+    raysets = ordered(r["rayset"] for r in rows)
+    lines = [f"- File: `{acc.name}`, {len(rows):,} rows (one thread each)",
+             f"- Scenes ({len(scenes)}): " + ", ".join(f"`{s}`" for s in scenes),
+             f"- Backends ({len(backends)}): " + ", ".join(f"`{b}`" for b in backends),
+             f"- Ray sets ({len(raysets)}): " + ", ".join(f"`{r}`" for r in raysets)]
+    if acc.meta:
+        lines.append(f"- Metadata: `{os.path.basename(meta_path(acc.path))}`")
+        lines += [f"- {label}: {text}" for label, text in run_facts(acc.meta) if text]
+    return lines + [
+        "", "Rates are % of the row's rays, judged against the exact referee; error = false "
+        "miss + false hit + wrong prim (a hit on a triangle the referee does not accept, "
+        "unambiguous rays only). Ambiguous rays lie within rounding of an edge or vertex. Self "
+        "hits: secondary rays that hit the primitive they start from. ulp: |t \u2212 t_exact| "
+        f"in float ulps at t_exact, over rays both hit. {DASH} = not applicable.", ""]
+
+
+def accuracy_section(acc, colors, used):
+    """The report's part for one accuracy file: its plots (Pareto per scene, stability sweep,
+    parameter sweeps, invalid-ray cost) and then its rows as tables, one per scene."""
+    plots = accuracy_pareto_plots(acc, colors, used)
+    plots += stability_plots(acc, colors, used)
+    plots += parameter_plots(acc, colors, used)
+    invalid = invalid_rays_plot(acc, colors, used)
+    plots += [invalid] if invalid else []
+    lines = [f"## Accuracy: `{acc.name}`", ""] + accuracy_summary(acc)
+    for section in ordered(p.section for p in plots):
+        lines += [f"### {section}", "", SECTION_INTROS[section], ""]
+        for p in (p for p in plots if p.section == section):
+            if p is invalid:
+                lines += [f"![{p.heading}]({p.filename})", ""]
+            else:
+                lines += image_lines(p.heading, p.filename, 4)
+            lines += p.extra
+    lines += ["### Results by scene", "",
+              "The scene as given; the stability sweep's other scales and offsets are listed "
+              "under their plot.", ""]
+    for scene, transforms in by_scene_transform(acc.rows).items():
+        base = base_transform(transforms)
+        if base is None:
+            continue
+        heading = scene + ("" if base == IDENTITY else f" ({fmt_transform(base)})")
+        lines += [f"#### {md_escape(heading)}", ""] + accuracy_table(transforms[base])
+    return plots, lines
 
 
 # ---------------------------------------------------------------------------------------------
@@ -735,12 +1391,34 @@ def plots_section(plots, intro):
     return lines
 
 
-def render_markdown(title, meta, csv_path, rows, plots, intro, scenes, backends, raysets):
-    lines = [f"# {title}", ""]
-    lines += run_section(meta, csv_path, rows)
+def results_part(csv_path, rows, meta, colors, with_pareto, used):
+    """The report's part for the results CSV: Run, throughput and ratio plots, the speed-versus-
+    error fallback (when no accuracy file gives real errors), and its tables."""
+    scenes = ordered(r["scene"] for r in rows)
+    raysets = ordered(r["rayset"] for r in rows)
+    backends = results_backends(rows)
+    all_threads = sorted(ordered(r["threads"] for r in rows))
+    triangles = {r["scene"]: r.get("triangles") for r in rows if r.get("triangles")}
+    plots = (throughput_plots(rows, scenes, backends, raysets, all_threads, colors, triangles)
+             + ratio_plots(rows, scenes, backends, raysets, all_threads, colors, triangles))
+    if with_pareto:
+        plots += pareto_plots(error_points_from_results(rows), raysets, colors, triangles, used)
+    intro = {"Ratio to Embree": "Ratios are measured within one run (same rays, same machine, "
+                                "repetitions interleaved), so they are more stable across runs "
+                                "than absolute Mrays/s.",
+             "Speed versus error": "No accuracy file given (`--accuracy`): the error here is "
+                                   "1 \u2212 agree_hit, disagreement with Embree, not an error "
+                                   "against ground truth; on must-hit ray sets (a `leaks` "
+                                   "value) it is leaks / rays, which is one."}
+    lines = run_section(meta, csv_path, rows)
     lines += plots_section(plots, intro)
     lines += tables_section(rows, scenes, backends, raysets)
-    return "\n".join(lines).rstrip() + "\n"
+    return plots, lines
+
+
+def results_backends(rows):
+    """The reference first, then the order the run listed its backends in."""
+    return sorted(ordered(r["backend"] for r in rows), key=lambda b: b != REFERENCE)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -786,53 +1464,57 @@ def parse_args(argv):
     parser = Parser(prog="scripts/report", description=__doc__.split("\n\n")[0],
                     epilog="Writes DIR/report.md and PNG plots beside it; see the top of "
                            "scripts/report.py for what each plot shows.")
-    parser.add_argument("csv", metavar="RESULTS.csv", help="a raybench results CSV")
+    parser.add_argument("csv", metavar="RESULTS.csv", nargs="?",
+                        help="a raybench results CSV (optional when --accuracy is given)")
     parser.add_argument("--out", metavar="DIR",
-                        help="output folder (default: <csv dir>/<csv stem>-report/)")
-    parser.add_argument("--accuracy", metavar="ACCURACY.csv",
-                        help="accuracy CSV (scene, rayset, backend, rays, false_miss, false_hit, "
-                             "wrong_prim, mrays_s) for the speed-versus-error plots; without it "
-                             "they use 1 - agree_hit (disagreement with Embree)")
+                        help="output folder (default: <dir>/<stem>-report/ of RESULTS.csv, "
+                             "else of the first --accuracy file)")
+    parser.add_argument("--accuracy", metavar="ACCURACY.csv", action="append", default=[],
+                        help="an accuracy CSV (results/accuracy.csv, results/accuracy-kernels.csv;"
+                             " schema in harness/src/accuracy/accuracy_csv.h); repeat for several "
+                             "files. Gives the speed-versus-error plots real errors, and adds the "
+                             "stability sweep, ray-set parameter and invalid-ray plots and tables. "
+                             "Without it the speed-versus-error plots use 1 - agree_hit "
+                             "(disagreement with Embree)")
     parser.add_argument("--title", metavar="TEXT", help="report title")
-    return parser.parse_args(argv)
+    args = parser.parse_args(argv)
+    if args.csv is None and not args.accuracy:
+        parser.error("nothing to report: give RESULTS.csv, --accuracy ACCURACY.csv, or both")
+    return args
+
+
+def default_title(csv_path, accuracy):
+    if csv_path:
+        return f"raybench report: {os.path.splitext(os.path.basename(csv_path))[0]}"
+    return "raybench accuracy report: " + ", ".join(acc.stem for acc in accuracy)
 
 
 def main(argv):
     args = parse_args(argv)
-    rows = read_table(args.csv, REQUIRED, NUMERIC)
-    meta = read_meta(args.csv)
-    accuracy = read_table(args.accuracy, ACCURACY_REQUIRED, ACCURACY_NUMERIC) \
-        if args.accuracy else None
-    out_dir = args.out or default_out_dir(args.csv)
+    rows = read_table(args.csv, REQUIRED, NUMERIC) if args.csv else []
+    meta = read_meta(args.csv) if args.csv else {}
+    accuracy = [read_accuracy(path) for path in args.accuracy]
+    out_dir = args.out or default_out_dir(args.csv or args.accuracy[0])
     if os.path.exists(out_dir) and not os.path.isdir(out_dir):
         raise InputError(out_dir, "exists and is not a directory")
 
-    scenes = ordered(r["scene"] for r in rows)
-    raysets = ordered(r["rayset"] for r in rows)
-    # The reference first, then the order the run listed its backends in.
-    backends = sorted(ordered(r["backend"] for r in rows), key=lambda b: b != REFERENCE)
-    all_threads = sorted(ordered(r["threads"] for r in rows))
-    triangles = {r["scene"]: r.get("triangles") for r in rows if r.get("triangles")}
-    extra = ordered(r["backend"] for r in accuracy or [] if r["backend"] not in backends)
-    colors = backend_colors(backends + extra)
-
-    groups = error_points_from_accuracy(accuracy) if accuracy else error_points_from_results(rows)
-    plots = (throughput_plots(rows, scenes, backends, raysets, all_threads, colors, triangles)
-             + ratio_plots(rows, scenes, backends, raysets, all_threads, colors, triangles)
-             + pareto_plots(groups, raysets, colors, triangles))
-    intro = {"Ratio to Embree": "Ratios are measured within one run (same rays, same machine, "
-                                "repetitions interleaved), so they are more stable across runs "
-                                "than absolute Mrays/s.",
-             "Speed versus error": (f"Errors from `{os.path.basename(args.accuracy)}`."
-                                    if accuracy else
-                                    "No accuracy file given (`--accuracy`): the error here is "
-                                    "1 \u2212 agree_hit, disagreement with Embree, not an error "
-                                    "against ground truth; on must-hit ray sets (a `leaks` "
-                                    "value) it is leaks / rays, which is one.")}
-    title = args.title or f"raybench report: {os.path.splitext(os.path.basename(args.csv))[0]}"
-    markdown = render_markdown(title, meta, args.csv, rows, plots, intro, scenes, backends,
-                               raysets)
-    write_report(out_dir, plots, markdown)
+    # One colour per backend: the results' backends keep theirs in every accuracy figure.
+    backends = results_backends(rows)
+    used = set()  # PNG names already taken: two scenes may sanitise to the same name
+    plots, lines = [], [f"# {args.title or default_title(args.csv, accuracy)}", ""]
+    if rows:
+        extra = ordered(r["backend"] for acc in accuracy for r in acc.rows
+                        if r["backend"] not in backends)
+        part_plots, part_lines = results_part(args.csv, rows, meta,
+                                              backend_colors(backends + extra), not accuracy, used)
+        plots += part_plots
+        lines += part_lines
+    for acc in accuracy:
+        own = ordered(r["backend"] for r in acc.rows if r["backend"] not in backends)
+        part_plots, part_lines = accuracy_section(acc, backend_colors(backends + own), used)
+        plots += part_plots
+        lines += part_lines
+    write_report(out_dir, plots, "\n".join(lines).rstrip() + "\n")
     print(os.path.join(out_dir, "report.md"))
     return 0
 

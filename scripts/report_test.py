@@ -1,20 +1,27 @@
-"""scripts/report driven as a user drives it, on small synthetic results CSVs: the report and
-every PNG it links exist and are real images, the tables hold every (scene, backend) pair, an
-accuracy file gives the speed-versus-error plots, and bad input exits 2 with one line on stderr
-and writes nothing.
+"""scripts/report driven as a user drives it, on small synthetic results and accuracy CSVs: the
+report and every PNG it links exist and are real images, the tables hold every (scene, backend)
+pair, accuracy files (alone, several, or beside a results CSV) give the speed-versus-error,
+stability-sweep, ray-set-parameter and invalid-ray plots and tables, and bad input exits 2 with
+one line on stderr and writes nothing. The data behind the accuracy plots (what is pooled, what
+is left out, the invalid-ray cost) is also checked directly on report.py's functions.
 
     /usr/bin/python3 -m unittest scripts/report_test.py     (from the repository root)
     /usr/bin/python3 scripts/report_test.py                 (from anywhere)
 """
 import csv
+import math
 import os
 import random
 import re
 import subprocess
+import sys
 import tempfile
 import unittest
 
-REPORT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "report")
+SCRIPTS = os.path.dirname(os.path.abspath(__file__))
+REPORT = os.path.join(SCRIPTS, "report")
+sys.path.insert(0, SCRIPTS)
+import report  # noqa: E402  (the data functions behind the plots, tested directly)
 
 # raybench's results schema (README, "Results").
 COLUMNS = ["scene", "triangles", "rayset", "query", "rays", "backend", "threads", "build_ms",
@@ -69,16 +76,101 @@ def results_rows(threads_list=(1,), seed=1):
     return rows
 
 
+# The accuracy schema (harness/src/accuracy/accuracy_csv.h), copied: the test checks the script
+# against the C++ side's column list, not against the script's own.
+ACCURACY_COLUMNS = ["scene", "scale", "offset_x", "offset_y", "offset_z", "rayset", "query",
+                    "backend", "accuracy_class", "rays", "invalid", "truth_hits", "ambiguous",
+                    "false_miss", "false_hit", "wrong_prim", "self_hits", "ulp_p50", "ulp_p99",
+                    "ulp_max", "mrays_s", "mrays_s_min", "mrays_s_max"]
+FAR_OFFSET = (148376, 1234, -223423)
+
+
+def accuracy_row(scene, rayset, backend, mrays_s, **fields):
+    """One accuracy row as raybench writes it: the scene as given, nothing wrong, unless told."""
+    row = {"scene": scene, "scale": 1, "offset_x": 0, "offset_y": 0, "offset_z": 0,
+           "rayset": rayset, "query": "intersect", "backend": backend,
+           "accuracy_class": "robust" if "robust" in backend else "fast", "rays": 4096,
+           "invalid": 0, "truth_hits": 0.5, "ambiguous": 0.001, "false_miss": 0,
+           "false_hit": 0, "wrong_prim": 0, "self_hits": "", "ulp_p50": 0.5, "ulp_p99": 3,
+           "ulp_max": 40, "mrays_s": mrays_s,
+           "mrays_s_min": "" if mrays_s == "" else mrays_s * 0.95,
+           "mrays_s_max": "" if mrays_s == "" else mrays_s * 1.05}
+    row.update(fields)
+    return row
+
+
 def accuracy_rows():
+    """Beside the results CSV: the same scenes, ray sets and backends, random error rates."""
     rng = random.Random(7)
-    rows = [{"scene": scene, "rayset": rayset, "backend": backend, "rays": 4096,
-             "false_miss": 0 if backend == "embree" else rng.choice([0, 1e-4, 3e-3]),
-             "false_hit": rng.choice([0, 2e-4]),
-             "wrong_prim": "" if rayset == "shadow" else rng.choice([0, 5e-4]),
-             "mrays_s": rng.uniform(1, 20)}
-            for scene in SCENES for rayset in RAYSETS for backend in BACKENDS]
+    rows = [accuracy_row(scene, rayset, backend, rng.uniform(1, 20),
+                         query=query,
+                         false_miss=0 if backend == "embree" else rng.choice([0, 1e-4, 3e-3]),
+                         false_hit=rng.choice([0, 2e-4]),
+                         wrong_prim="" if query == "occluded" else rng.choice([0, 5e-4]))
+            for scene in SCENES for rayset, query in RAYSETS.items() for backend in BACKENDS]
     # Two backends on the same spot: their labels must be placed apart (and placing them end).
     rows[2].update({k: rows[1][k] for k in ("false_miss", "false_hit", "wrong_prim", "mrays_s")})
+    return rows
+
+
+SCENE_BACKENDS = ["embree", "embree:robust", "bvh2", "bvh2:watertight", "bvh8", "reference"]
+SWEEP_SCALES = [1e-6, 1e-3, 1, 1e3, 1e6]
+SWEEP_OFFSETS = [(0, 0, 0), FAR_OFFSET, (1e7, 0, 0)]
+SLOW_ON_INVALID = "bvh8"     # 3x slower on invalid rays than on control-random: over the bar
+HITS_INVALID = "bvh2"        # answers a hit for 0.5 % of the invalid rays
+
+
+def scene_accuracy_rows():
+    """results/accuracy.csv in small: two scenes with control-random and invalid-rays ray sets,
+    and a stability sweep of "sphere" over scale and offset, where bvh2 degrades with scale
+    but is exact as given (so a sweep row in its Pareto point would show)."""
+    rows = []
+    speed = {b: 10.0 - i for i, b in enumerate(SCENE_BACKENDS)}
+    for scene in ("bunny", "proc:terrain_spheres"):
+        for backend in SCENE_BACKENDS:
+            mrays = "" if backend == "reference" else speed[backend]  # the referee: untimed
+            rows.append(accuracy_row(scene, "control-random", backend, mrays,
+                                     wrong_prim=0 if "robust" in backend else 2e-4))
+            rows.append(accuracy_row(scene, "vertex-aimed", backend, mrays,
+                                     false_miss=0.1 if backend == "bvh2" else 0,
+                                     ambiguous=0.3))
+            slowdown = 3.0 if backend == SLOW_ON_INVALID else 1.2
+            rows.append(accuracy_row(scene, "invalid-rays", backend,
+                                     "" if mrays == "" else mrays / slowdown,
+                                     invalid=1, truth_hits=0, ulp_p50="", ulp_p99="",
+                                     ulp_max="", false_hit=0.005 if backend == HITS_INVALID else 0))
+    for scale in SWEEP_SCALES:
+        for offset in SWEEP_OFFSETS:
+            for backend in ("embree", "bvh2", "bvh2:watertight"):
+                error = 0 if backend != "bvh2" or scale == 1 else 1e-3 * abs(math.log10(scale))
+                rows.append(accuracy_row("sphere", "closed-inside-random", backend,
+                                         speed[backend], scale=scale, offset_x=offset[0],
+                                         offset_y=offset[1], offset_z=offset[2],
+                                         false_miss=error, truth_hits=1))
+    return rows
+
+
+KERNELS = ["kernel:seed", "kernel:haines", "kernel:pbrt"]
+FAR_DISTANCES = ["1e2", "1e3", "1e4", "1e6", "1e10"]
+
+
+def kernel_accuracy_rows():
+    """results/accuracy-kernels.csv in small: single primitives, a parametrised ray-set family
+    (far-small-sphere:D=...) where the seed kernel breaks from D=1e4 on."""
+    rows = []
+    for i, kernel in enumerate(KERNELS):
+        speed = 200.0 - 40 * i
+        for d in FAR_DISTANCES:
+            error = 0.5 if kernel == "kernel:seed" and float(d) >= 1e4 else 0
+            rows.append(accuracy_row("prim:sphere", f"far-small-sphere:D={d}", kernel, speed,
+                                     false_miss=error / 2, false_hit=error / 2,
+                                     wrong_prim="", accuracy_class="epsilon"))
+        rows.append(accuracy_row("prim:sphere", "origin-inside", kernel, speed,
+                                 false_miss=0.25 if kernel == "kernel:seed" else 0))
+        for scene in ("prim:sphere", "prim:box"):
+            rows.append(accuracy_row(scene, "control-random", kernel, speed))
+            rows.append(accuracy_row(scene, "invalid-rays", kernel, speed / 1.5, invalid=1,
+                                     truth_hits=0, false_hit=1 if kernel == "kernel:seed" else 0))
     return rows
 
 
@@ -128,7 +220,7 @@ class ReportTestCase(unittest.TestCase):
         with open(cls.path("run.meta.toml"), "w") as f:
             f.write(META)
         write_csv(cls.path("threads.csv"), results_rows((1, 2), seed=2), COLUMNS)
-        write_csv(cls.path("accuracy.csv"), accuracy_rows(), list(accuracy_rows()[0]))
+        write_csv(cls.path("accuracy.csv"), accuracy_rows(), ACCURACY_COLUMNS)
         # A relative path from the CSV's folder: the default out dir and any working directory.
         cls.plain = run_report("run.csv", cwd=cls.dir)
         cls.threads = run_report(cls.path("threads.csv"), "--out", cls.path("threads-out"))
@@ -217,8 +309,14 @@ class ReportTestCase(unittest.TestCase):
         self.assertTrue(markdown.startswith("# My title\n"))
         self.assertEqual(sorted(l for l in links if l.startswith("pareto-")),
                          ["pareto-bunny.png", "pareto-proc_terrain_spheres.png"])
-        self.assertIn("accuracy.csv", markdown)
+        self.assertIn("## Accuracy: `accuracy.csv`", markdown)
         self.assertNotIn("disagreement with Embree, not an error", markdown)
+        # The results part is all there, before the accuracy part.
+        for rayset in RAYSETS:
+            self.assertIn(f"throughput-{rayset}.png", links)
+        self.assertLess(markdown.index("## Tables"), markdown.index("## Accuracy"))
+        self.assertEqual(table_pairs(markdown.split("## Accuracy")[0]),
+                         {(s, b, 1) for s in SCENES for b in BACKENDS})
 
     def test_must_hit_rayset_shows_leaks(self):
         markdown, links = self.assertGoodReport(self.must_hit, self.path("must-hit-out"))
@@ -235,6 +333,226 @@ class ReportTestCase(unittest.TestCase):
         self.assertEqual(result.returncode, 0)
         self.assertIn("usage:", result.stdout)
         self.assertIn("--accuracy", result.stdout)
+
+
+def section(markdown, heading):
+    """The text under a Markdown heading, up to the next heading of the same or higher level."""
+    level = heading.split(" ", 1)[0]
+    body = markdown.split(heading + "\n", 1)[1]
+    ends = [m.start() for m in re.finditer(r"^#{1,%d} " % len(level), body, re.M)]
+    return body[:ends[0]] if ends else body
+
+
+def table_rows(text):
+    """Cells of every Markdown table body row in text (header and rule left out)."""
+    rows, header = [], None
+    for line in text.splitlines():
+        if not line.startswith("|"):
+            header = None
+            continue
+        cells = [c.strip() for c in line.strip().strip("|").split(" | ")]
+        if header is None:
+            header = cells
+        elif not line.startswith("|---"):
+            rows.append(dict(zip(header, cells)))
+    return rows
+
+
+class AccuracyReportTestCase(ReportTestCase):
+    """Accuracy files alone and several at once: one report each, made once."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.dir = cls.tmp.name
+        write_csv(cls.path("acc.csv"), scene_accuracy_rows(), ACCURACY_COLUMNS)
+        write_csv(cls.path("kernels.csv"), kernel_accuracy_rows(), ACCURACY_COLUMNS)
+        # No RESULTS.csv and no --out: the folder comes from the (first) accuracy file.
+        cls.alone = run_report("--accuracy", "acc.csv", cwd=cls.dir)
+        cls.both = run_report("--accuracy", cls.path("acc.csv"), "--accuracy",
+                              cls.path("kernels.csv"), "--out", cls.path("both-out"))
+
+    # ReportTestCase's tests are for results files: not run again here.
+    test_default_out_dir_and_relative_path = None
+    test_tables_hold_every_scene_backend_pair = None
+    test_empty_fields_show_a_dash = None
+    test_plots_per_rayset_and_fallback_pareto = None
+    test_run_section_from_meta = None
+    test_several_thread_counts = None
+    test_accuracy_file_gives_pareto_plots = None
+    test_must_hit_rayset_shows_leaks = None
+    test_help = None
+
+    def test_accuracy_alone(self):
+        markdown, links = self.assertGoodReport(self.alone, self.path("acc-report"))
+        self.assertEqual(sorted(links), ["invalid-rays-acc.png", "pareto-bunny.png",
+                                         "pareto-proc_terrain_spheres.png", "pareto-sphere.png",
+                                         "sweep-sphere.png"])
+        self.assertTrue(markdown.startswith("# raybench accuracy report: acc\n"), markdown[:80])
+        for heading in ("## Accuracy: `acc.csv`", "### Speed versus error",
+                        "### Stability under scale and offset", "### Invalid rays",
+                        "### Results by scene", "#### bunny", "#### proc:terrain_spheres",
+                        "#### sphere"):
+            self.assertIn(f"\n{heading}\n", markdown)
+        for absent in ("## Run", "## Tables", "## Throughput", "## Ratio to Embree"):
+            self.assertNotIn(f"\n{absent}\n", markdown)
+
+    def test_results_by_scene_hold_every_row_as_given(self):
+        markdown = self.read_report(self.path("acc-report"))
+        tables = section(markdown, "### Results by scene")
+        for scene in ("bunny", "proc:terrain_spheres"):
+            rows = table_rows(section(tables, f"#### {scene}"))
+            self.assertEqual({(r["ray set"], r["backend"]) for r in rows},
+                             {(rs, b) for rs in ("control-random", "vertex-aimed", "invalid-rays")
+                              for b in SCENE_BACKENDS})
+        vertex = {r["backend"]: r for r in table_rows(section(tables, "#### bunny"))
+                  if r["ray set"] == "vertex-aimed"}
+        self.assertEqual(vertex["bvh2"]["false miss"], "10 %")
+        self.assertEqual(vertex["bvh2"]["error"], "10 %")
+        self.assertEqual(vertex["embree"]["false miss"], "0")
+        self.assertEqual(vertex["embree"]["ambiguous"], "30 %")
+        self.assertEqual(vertex["reference"]["Mrays/s"], "\u2013")  # untimed: a dash
+        # The sweep's scaled and moved copies of "sphere" are not in its table, only under
+        # the sweep plot.
+        sphere = table_rows(section(tables, "#### sphere"))
+        self.assertEqual(len(sphere), 3)
+        sweep = section(markdown, "### Stability under scale and offset")
+        details = sweep.split("<details>", 1)[1]
+        self.assertEqual(len(table_rows(details)),
+                         len(SWEEP_SCALES) * len(SWEEP_OFFSETS) * 3)
+
+    def test_sweep_table_is_error_against_scale(self):
+        sweep = section(self.read_report(self.path("acc-report")),
+                        "### Stability under scale and offset").split("<details>", 1)[0]
+        rows = {r["backend at offset"]: r for r in table_rows(sweep)}
+        self.assertEqual(len(rows), 3 * len(SWEEP_OFFSETS))
+        self.assertEqual(rows["bvh2 at 0"]["scale 1e6"], "0.6 %")
+        self.assertEqual(rows["bvh2 at 0"]["scale 1e-3"], "0.3 %")
+        self.assertEqual(rows["bvh2 at 0"]["scale 1"], "0")
+        self.assertEqual(rows["bvh2 at (148376, 1234, -223423)"]["scale 1e6"], "0.6 %")
+        self.assertEqual(rows["embree at (1e7, 0, 0)"]["scale 1e6"], "0")
+
+    def test_invalid_rays_against_embrees_bar(self):
+        text = section(self.read_report(self.path("acc-report")), "### Invalid rays")
+        self.assertIn("![Invalid rays](invalid-rays-acc.png)", text)
+        rows = {(r["scene"], r["backend"]): r for r in table_rows(text)}
+        timed = [b for b in SCENE_BACKENDS if b != "reference"]  # no speed, no bar
+        self.assertEqual(set(rows), {(s, b) for s in ("bunny", "proc:terrain_spheres")
+                                     for b in timed})
+        for (scene, backend), row in rows.items():
+            slow = backend == SLOW_ON_INVALID
+            self.assertEqual(row["invalid / valid time"], "3\u00d7" if slow else "1.2\u00d7")
+            self.assertEqual(row["\u2264 2.5\u00d7"], "**no**" if slow else "yes", backend)
+            missed = row["all invalid rays missed"]
+            if backend == HITS_INVALID:
+                self.assertEqual(missed, "**no**: 0.5 % hit")
+            else:
+                self.assertEqual(missed, "yes")
+
+    def test_several_accuracy_files(self):
+        markdown, links = self.assertGoodReport(self.both, self.path("both-out"))
+        self.assertTrue(markdown.startswith("# raybench accuracy report: acc, kernels\n"))
+        self.assertLess(markdown.index("## Accuracy: `acc.csv`"),
+                        markdown.index("## Accuracy: `kernels.csv`"))
+        self.assertEqual(sorted(links), sorted([
+            "invalid-rays-acc.png", "pareto-bunny.png", "pareto-proc_terrain_spheres.png",
+            "pareto-sphere.png", "sweep-sphere.png", "invalid-rays-kernels.png",
+            "pareto-prim_sphere.png", "pareto-prim_box.png", "parameters-prim_sphere.png"]))
+        kernels = markdown.split("## Accuracy: `kernels.csv`", 1)[1]
+        self.assertNotIn("### Stability under scale and offset", kernels)
+        parameter = section(kernels, "### Error against a ray-set parameter")
+        rows = {r["backend"]: r for r in table_rows(parameter)}
+        self.assertEqual(set(rows), set(KERNELS))
+        self.assertEqual([k for k in rows["kernel:seed"] if k != "backend"],
+                         [f"D={d}" for d in FAR_DISTANCES])
+        self.assertEqual(rows["kernel:seed"]["D=1e3"], "0")
+        self.assertEqual(rows["kernel:seed"]["D=1e4"], "50 %")
+        self.assertEqual(rows["kernel:pbrt"]["D=1e10"], "0")
+        invalid = {(r["scene"], r["backend"]): r
+                   for r in table_rows(section(kernels, "### Invalid rays"))}
+        self.assertEqual(invalid[("prim:box", "kernel:seed")]["all invalid rays missed"],
+                         "**no**: 100 % hit")
+        self.assertEqual(invalid[("prim:box", "kernel:pbrt")]["invalid / valid time"], "1.5\u00d7")
+
+
+class AccuracyDataTestCase(unittest.TestCase):
+    """What goes into each accuracy plot, from report.py's functions on a parsed file."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.scene_path = os.path.join(cls.tmp.name, "acc.csv")
+        cls.kernel_path = os.path.join(cls.tmp.name, "kernels.csv")
+        write_csv(cls.scene_path, scene_accuracy_rows(), ACCURACY_COLUMNS)
+        write_csv(cls.kernel_path, kernel_accuracy_rows(), ACCURACY_COLUMNS)
+        cls.scene = report.read_accuracy(cls.scene_path)
+        cls.kernels = report.read_accuracy(cls.kernel_path)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_sweep_rows_stay_out_of_the_pareto_plot(self):
+        base, panels = report.scene_pareto_panels(self.scene.rows)["sphere"]
+        self.assertEqual(base, report.IDENTITY)
+        self.assertEqual(len(panels), 1)
+        _, points = panels[0]
+        # bvh2 is wrong at every scale but 1: pooled with the sweep it would not be 0.
+        self.assertEqual({p["backend"]: p["error"] for p in points},
+                         {"embree": 0, "bvh2": 0, "bvh2:watertight": 0})
+        self.assertEqual({p["rays"] for p in points}, {4096})
+
+    def test_untimed_rows_have_no_pareto_point(self):
+        _, panels = report.scene_pareto_panels(self.scene.rows)["bunny"]
+        for _, points in panels:
+            self.assertNotIn("reference", {p["backend"] for p in points})
+
+    def test_parametrised_ray_sets_pool_into_one_panel(self):
+        _, panels = report.scene_pareto_panels(self.kernels.rows)["prim:sphere"]
+        titles = [title for title, _ in panels]
+        self.assertEqual(titles[0], "far-small-sphere, D=1e2..1e10 pooled")
+        seed = next(p for p in panels[0][1] if p["backend"] == "kernel:seed")
+        self.assertAlmostEqual(seed["error"], 3 * 0.5 / 5)  # 3 of 5 equal-sized sets at 50 %
+        self.assertEqual(seed["rays"], 5 * 4096)
+
+    def test_pooled_rates_and_speed(self):
+        rows = [{"rays": 1000, "mrays_s": 10.0, "false_miss": 0.1, "false_hit": None,
+                 "wrong_prim": 0.0},
+                {"rays": 3000, "mrays_s": 30.0, "false_miss": 0.0, "false_hit": None,
+                 "wrong_prim": None}]
+        self.assertAlmostEqual(report.pooled(rows, report.error_rate), 0.025)
+        # 4000 rays in 1000/10 + 3000/30 = 200 microseconds: 20 Mrays/s, not the mean 20 of
+        # the rates by chance; make the second set slower to tell the two apart.
+        rows[1]["mrays_s"] = 3.0
+        self.assertAlmostEqual(report.pooled_speed(rows), 4000 / (100 + 1000))
+        self.assertIsNone(report.pooled(rows, lambda r: r["false_hit"]))
+
+    def test_invalid_ray_cost(self):
+        costs = {(c["group"], c["backend"]): c for c in report.invalid_ray_costs(self.scene)}
+        self.assertAlmostEqual(costs[("bunny", SLOW_ON_INVALID)]["slowdown"], 3.0)
+        self.assertAlmostEqual(costs[("bunny", "embree")]["slowdown"], 1.2)
+        self.assertEqual(costs[("bunny", HITS_INVALID)]["false_hit"], 0.005)
+        self.assertNotIn(("bunny", "reference"), costs)
+        self.assertNotIn("sphere", {group for group, _ in costs})  # no invalid-rays set
+
+    def test_rayset_parameter(self):
+        self.assertEqual(report.rayset_parameter("far-small-sphere:D=1e3"),
+                         ("far-small-sphere", "D", 1000.0))
+        self.assertEqual(report.rayset_parameter("tiny-sphere:r=3.4e-4"),
+                         ("tiny-sphere", "r", 3.4e-4))
+        self.assertEqual(report.rayset_parameter("control-random"),
+                         ("control-random", None, None))
+        self.assertEqual(report.rayset_parameter("far-offset:mode=edge"),
+                         ("far-offset:mode=edge", None, None))
+
+    def test_rates_as_percentages(self):
+        self.assertEqual(report.fmt_rate(0), "0")
+        self.assertEqual(report.fmt_rate(None), "\u2013")
+        self.assertEqual(report.fmt_rate(0.0016), "0.16 %")
+        self.assertEqual(report.fmt_rate(1 / 4096), "0.0244 %")
+        self.assertEqual(report.fmt_rate(1e-7), "1e-5 %")  # never a rounded "0"
+        self.assertEqual(report.fmt_rate(0.9999999), "99.99999 %")  # never a rounded "100"
+        self.assertEqual(report.fmt_rate(1), "100 %")
 
 
 class BadInputTestCase(unittest.TestCase):
@@ -296,6 +614,57 @@ class BadInputTestCase(unittest.TestCase):
     def test_bad_accuracy_file(self):
         bad = self.write("acc.csv", "scene,rayset,backend\nbunny,primary,embree\n")
         self.assertBadInput(bad, self.good, "--accuracy", bad)
+
+    def write_accuracy(self, name, rows, columns=ACCURACY_COLUMNS):
+        path = os.path.join(self.dir, name)
+        write_csv(path, [{c: r[c] for c in columns} for r in rows], columns)
+        return path
+
+    def test_accuracy_alone_missing_column(self):
+        columns = [c for c in ACCURACY_COLUMNS if c != "wrong_prim"]
+        path = self.write_accuracy("acc.csv", scene_accuracy_rows(), columns)
+        self.assertBadInput(path, "--accuracy", path)
+
+    def test_accuracy_not_a_number(self):
+        rows = scene_accuracy_rows()
+        rows[3]["false_hit"] = "lots"
+        path = self.write_accuracy("acc.csv", rows)
+        self.assertBadInput(path, "--accuracy", path)
+
+    def test_accuracy_empty_scale(self):
+        rows = scene_accuracy_rows()
+        rows[0]["scale"] = ""
+        path = self.write_accuracy("acc.csv", rows)
+        self.assertBadInput(path, "--accuracy", path)
+
+    def test_accuracy_duplicate_row(self):
+        rows = scene_accuracy_rows()
+        path = self.write_accuracy("acc.csv", rows + [dict(rows[4], mrays_s=1)])
+        self.assertBadInput(path, "--accuracy", path)
+
+    def test_second_accuracy_file_bad(self):
+        good = self.write_accuracy("acc.csv", scene_accuracy_rows())
+        bad = self.write("kernels.csv", "")
+        self.assertBadInput(bad, "--accuracy", good, "--accuracy", bad)
+
+    def test_results_good_accuracy_missing(self):
+        missing = os.path.join(self.dir, "nope.csv")
+        self.assertBadInput(missing, self.good, "--accuracy", missing)
+
+    def test_nothing_to_report(self):
+        result = run_report("--out", os.path.join(self.dir, "out"))
+        self.assertEqual(result.returncode, 2, result.stderr)
+        self.assertEqual(result.stderr, "report: error: nothing to report: give RESULTS.csv, "
+                                        "--accuracy ACCURACY.csv, or both\n")
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "out")))
+
+    def test_accuracy_default_out_dir_not_created(self):
+        columns = [c for c in ACCURACY_COLUMNS if c != "mrays_s"]
+        self.write_accuracy("acc.csv", scene_accuracy_rows(), columns)
+        result = run_report("--accuracy", "acc.csv", cwd=self.dir)
+        self.assertEqual(result.returncode, 2)
+        self.assertNotIn("Traceback", result.stderr)
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "acc-report")))
 
     def test_default_out_dir_not_created(self):
         empty = self.write("empty.csv", "")
