@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "accuracy/kernel_accuracy.h"
 #include "agreement.h"
 #include "build_info.h"
 #include "backend.h"
@@ -145,6 +146,21 @@ int run(int argc, char** argv) {
   kernels_cmd->add_option("--min-time", kernel_options.min_time, "Minimum seconds per repetition")->capture_default_str()->check(CLI::PositiveNumber);
   kernels_cmd->add_option("--pairs", kernel_options.pairs, "Ray-primitive pairs per family and input")->capture_default_str();
 
+  // raybench accuracy-kernels
+  KernelAccuracyOptions kernel_accuracy_options;
+  kernel_accuracy_options.out_csv = std::string(RAYBENCH_SOURCE_DIR) + "/results/accuracy-kernels.csv";
+  CLI::App* accuracy_kernels_cmd = app.add_subcommand(
+      "accuracy-kernels", "Judge every box, OBB, sphere and triangle kernel variant alone on the extreme ray sets "
+                          "against exact referees, and time it (accuracy CSV)");
+  accuracy_kernels_cmd->add_option("--out,-o", kernel_accuracy_options.out_csv, "Accuracy CSV (+ .meta.toml beside it)")
+      ->capture_default_str();
+  accuracy_kernels_cmd->add_option("--filter", kernel_accuracy_options.filter,
+                                   "Only rows whose <scene>/<rayset>/<backend> contains this, e.g. prim:sphere or kernel:slab_seed");
+  accuracy_kernels_cmd->add_option("--rays,-n", kernel_accuracy_options.rays, "Rays per ray set")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  accuracy_kernels_cmd->add_option("--seed", kernel_accuracy_options.seed, "Ray generation seed")->capture_default_str();
+
   // raybench compare
   std::string compare_base, compare_current, compare_format = "table", compare_out;
   bool compare_force = false;
@@ -235,6 +251,13 @@ int run(int argc, char** argv) {
     std::cout << fmt::format("gate: {} ({} rows compared against {}, {} failure{})\n", g.failures.empty() ? "PASS" : "FAIL",
                              current.rows.size(), gate_baseline, g.failures.size(), g.failures.size() == 1 ? "" : "s");
     return g.failures.empty() ? 0 : 1;
+  }
+  if (*accuracy_kernels_cmd) {
+    kernel_accuracy_options.command_line = command_line(argc, argv);
+    const std::vector<AccuracyRow> rows = run_kernel_accuracy(kernel_accuracy_options);
+    std::cout << format_kernel_accuracy_table(rows);
+    fmt::print("results: {} ({} rows)\n", kernel_accuracy_options.out_csv, rows.size());
+    return 0;
   }
   if (*kernels_cmd) {
     kernel_options.command_line = command_line(argc, argv);
