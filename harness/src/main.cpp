@@ -158,7 +158,7 @@ int run(int argc, char** argv) {
                                    "Only rows whose <scene>/<rayset>/<backend> contains this, e.g. prim:sphere or kernel:slab_seed");
   accuracy_kernels_cmd->add_option("--rays,-n", kernel_accuracy_options.rays, "Rays per ray set")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 24));
   accuracy_kernels_cmd->add_option("--seed", kernel_accuracy_options.seed, "Ray generation seed")->capture_default_str();
 
   // raybench compare
