@@ -19,11 +19,14 @@ struct AccuracyRow {
   std::string rayset;
   std::string query;    // intersect | occluded
   std::string backend;  // a backend name, or kernel:<variant> for single-primitive rows
-  std::string accuracy_class;  // fast | robust | epsilon | exact
+  std::string accuracy_class;  // fast | epsilon | watertight | robust | conservative | reference | exact
   std::size_t rays = 0;
   double invalid = 0.0;     // untraceable rays (NaN, Inf, ...): the truth for them is a miss
   double truth_hits = 0.0;  // rays the referee says hit (are occluded)
-  double ambiguous = 0.0;   // rays within rounding of an edge or vertex, or with tied nearest hits
+  // Scenes: rays within the referee's ambiguity band of an edge or vertex,
+  // or with tied nearest hits. Single primitives: rays that touch the
+  // primitive only at t = max(tnear, 0) (a closed-at-tnear kernel hits them).
+  double ambiguous = 0.0;
   double false_miss = 0.0;  // the referee says hit, the backend misses
   double false_hit = 0.0;   // the referee says miss, the backend hits
   double wrong_prim = 0.0;  // both hit, the backend's primitive is not one the referee accepts (unambiguous rays only)
