@@ -44,4 +44,12 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   }
 }
 
+void check_writable(const std::string& path) {
+  std::error_code ec;
+  const std::string probe = path + ".probe." + std::to_string(::getpid());
+  write_file_atomically(probe, [](std::ostream&) {});
+  std::filesystem::remove(probe, ec);
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory");
+}
+
 }  // namespace raybench

@@ -13,4 +13,8 @@ namespace raybench {
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write,
                            std::ios::openmode mode = std::ios::out);
 
+// Checks, before a long run, that `path` could be written later: its folder
+// exists (or is created) and accepts a file. Throws InputError naming `path`.
+void check_writable(const std::string& path);
+
 }  // namespace raybench

@@ -15,6 +15,7 @@
 
 #include "accuracy/judge.h"
 #include "agreement.h"
+#include "atomic_file.h"
 #include "backend.h"
 #include "error.h"
 #include "gbench.h"
@@ -86,6 +87,8 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
   for (const std::string& b : settings.backends) make_backend(b);
   if (settings.rays == 0) throw InputError("", "--rays must be at least 1");
   if (settings.repetitions < 1) throw InputError("", "--reps must be at least 1");
+  check_writable(options.out_csv);
+  if (!options.accuracy_csv.empty()) check_writable(options.accuracy_csv);
   std::vector<std::string> names = options.scenes;
   if (names.empty()) {
     for (const SuiteScene& s : options.suite.scenes) {

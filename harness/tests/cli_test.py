@@ -33,8 +33,8 @@ class CliTestCase(unittest.TestCase):
     def tearDown(self):
         self.tmp.cleanup()
 
-    def path(self, name):
-        return os.path.join(self.dir, name)
+    def path(self, *names):
+        return os.path.join(self.dir, *names)
 
     def assertBadInput(self, result, *fragments):
         """Exit 2 and one error line on stderr, the last, naming each fragment (progress lines may precede it)."""
@@ -224,6 +224,31 @@ class SuiteRun(CliTestCase):
             self.assertEqual(rows[(rayset, "bvh2:watertight:robust")]["leaks"], "0")
         # Embree's default mode is not watertight (EXTREMES.md: ~22 % of vertex-aimed rays miss).
         self.assertGreater(int(rows[("vertex-aimed", "embree")]["leaks"]), 100)
+
+    def test_accuracy_judges_every_ray_and_writes_its_own_csv(self):
+        out, accuracy = self.path("run.csv"), self.path("acc", "accuracy.csv")
+        result = run("run", "--scene", "proc:tiny_triangles", "--rayset", "tiny-triangles,invalid-rays", "--rays", "3000",
+                     "--reps", "1", "--build-reps", "1", "--min-time", "0.01", "--backend", "embree,bvh2:mt_seed,reference",
+                     "--out", out, "--rays-dir", self.path("rays"), "--accuracy", accuracy)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertTrue(os.path.exists(accuracy[:-len(".csv")] + ".meta.toml"))
+        _, rows = read_csv(accuracy)
+        by = {(r["rayset"], r["backend"]): r for r in rows}
+        self.assertEqual(len(rows), 6)
+        self.assertEqual(float(by[("tiny-triangles", "reference")]["false_miss"]), 0.0)
+        # The triangle seed's det < 1e-4 hides every tiny triangle the referee says is hit.
+        self.assertEqual(float(by[("tiny-triangles", "bvh2:mt_seed")]["false_miss"]),
+                         float(by[("tiny-triangles", "bvh2:mt_seed")]["truth_hits"]))
+        for backend in ("embree", "bvh2:mt_seed", "reference"):
+            self.assertEqual(float(by[("invalid-rays", backend)]["false_hit"]), 0.0)
+
+    def test_an_unwritable_accuracy_file_fails_before_the_run(self):
+        blocker = self.path("file")
+        open(blocker, "w").close()
+        result = run("run", "--scene", "proc:sphere", "--rays", "100", "--out", self.path("run.csv"),
+                     "--rays-dir", self.path("rays"), "--accuracy", os.path.join(blocker, "acc.csv"))
+        self.assertBadInput(result, "acc.csv")
+        self.assertFalse(os.path.exists(self.path("run.csv")))
 
     def test_a_bad_run_request_fails_before_writing_anything(self):
         out = self.path("never.csv")
