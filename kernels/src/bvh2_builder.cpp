@@ -165,13 +165,14 @@ Bvh2 build_bvh2_binned_sah(std::span<const Triangle> triangles, const Bvh2BuildO
   return bvh;
 }
 
-double Bvh2::sah_cost() const {
+double Bvh2::sah_cost(int leaf_granularity) const {
   const double root_area = nodes.empty() ? 0.0 : nodes[0].bounds.half_area();
   if (!(root_area > 0.0)) return 0.0;
+  const auto g = static_cast<std::uint32_t>(std::max(1, leaf_granularity));
   double cost = 0.0;
   for (const Bvh2Node& n : nodes) {
     const double area = n.bounds.half_area();
-    cost += n.is_leaf() ? area * n.prim_count : area;  // traversal and intersection cost 1
+    cost += n.is_leaf() ? area * ((n.prim_count + g - 1) / g) : area;  // traversal and intersection cost 1
   }
   return cost / root_area;
 }

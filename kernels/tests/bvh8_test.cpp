@@ -1,13 +1,16 @@
-// Specification of the 8-wide BVH (bvh/bvh8.h, bvh/bvh8_traverse.h): the
-// collapse keeps every triangle exactly once under bounds that contain it,
-// and traversal answers exactly as testing every triangle does.
+// Specification of the 8-wide BVH (bvh/bvh8.h, bvh/bvh8_traverse.h), over
+// the BVH2 of every builder: the collapse keeps every triangle exactly once
+// under bounds that contain it, and traversal answers exactly as testing
+// every triangle does.
 #include <random>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "bvh_test_util.h"
 
+#include "raybench/bvh/bvh2_builders.h"
 #include "raybench/bvh/bvh8_traverse.h"
 #include "raybench/geometry/uv_sphere.h"
 
@@ -19,7 +22,15 @@ using testing::random_soup;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-Bvh8 build(const std::vector<Triangle>& tris) { return collapse_to_bvh8(build_bvh2_binned_sah(tris), tris); }
+class Bvh8Build : public ::testing::TestWithParam<Bvh2Builder> {
+ protected:
+  // As the bvh8 backend builds it: the SAH counts leaf tests in packs of 8.
+  Bvh8 build(const std::vector<Triangle>& tris) const {
+    Bvh2BuildOptions options;
+    options.leaf_granularity = 8;
+    return collapse_to_bvh8(build_bvh2(tris, GetParam(), options), tris);
+  }
+};
 
 BBox lane_box(const BBox8& b, int lane) {
   BBox box;
@@ -59,7 +70,7 @@ void check(const Bvh8& bvh, const std::vector<Triangle>& tris, std::uint32_t nod
   }
 }
 
-TEST(Bvh8, EveryTriangleInExactlyOneLeafUnderBoundsThatContainIt) {
+TEST_P(Bvh8Build, EveryTriangleInExactlyOneLeafUnderBoundsThatContainIt) {
   for (std::size_t n : {1u, 7u, 9u, 5000u}) {
     const auto tris = random_soup(n, 1);
     const Bvh8 bvh = build(tris);
@@ -73,20 +84,17 @@ TEST(Bvh8, EveryTriangleInExactlyOneLeafUnderBoundsThatContainIt) {
   }
 }
 
-TEST(Bvh8, ClosestAndAnyHitMatchBruteForce) {
-  const auto tris = random_soup(4000, 2);
-  const Bvh8 bvh = build(tris);
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f), len(0.0f, 25.0f);
+// Closest and any hit of every ray against brute force; returns the number
+// of rays that hit. Exact ties in t may name either triangle.
+int expect_same_hits_as_brute_force(const Bvh8& bvh, const std::vector<Triangle>& tris, const std::vector<Ray>& rays) {
   int hits = 0;
-  for (int i = 0; i < 4000; ++i) {
-    Ray r{{u(rng) * 15, u(rng) * 15, u(rng) * 15}, 0.0f, normalize(Vec3f{u(rng), u(rng), u(rng)}), kInf};
-    if (i % 2) r.tfar = len(rng);
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const Ray& r = rays[i];
     const Hit expected = brute_force_closest(tris, r);
     const Hit got = intersect_bvh8(bvh, r);
-    ASSERT_EQ(got.hit(), expected.hit()) << "ray " << i;
+    EXPECT_EQ(got.hit(), expected.hit()) << "ray " << i;
     EXPECT_EQ(occluded_bvh8(bvh, r), expected.hit()) << "ray " << i;
-    if (!expected.hit()) continue;
+    if (!expected.hit() || !got.hit()) continue;
     ++hits;
     EXPECT_EQ(got.t, expected.t) << "ray " << i;
     if (got.prim != expected.prim) EXPECT_EQ(got.t, expected.t);  // an exact tie: either is right
@@ -95,10 +103,35 @@ TEST(Bvh8, ClosestAndAnyHitMatchBruteForce) {
       EXPECT_EQ(got.v, expected.v);
     }
   }
-  EXPECT_GT(hits, 500);  // the comparison covers many hits, not only misses
+  return hits;
 }
 
-TEST(Bvh8, FindsTheClosedSphereFromInsideAndNothingOutsideIt) {
+TEST_P(Bvh8Build, ClosestAndAnyHitMatchBruteForce) {
+  const auto tris = random_soup(4000, 2);
+  const Bvh8 bvh = build(tris);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), len(0.0f, 25.0f);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 4000; ++i) {
+    Ray r{{u(rng) * 15, u(rng) * 15, u(rng) * 15}, 0.0f, normalize(Vec3f{u(rng), u(rng), u(rng)}), kInf};
+    if (i % 2) r.tfar = len(rng);
+    rays.push_back(r);
+  }
+  EXPECT_GT(expect_same_hits_as_brute_force(bvh, tris, rays), 500);  // many hits, not only misses
+}
+
+TEST_P(Bvh8Build, EveryRayKindOnAMeshMatchesBruteForce) {
+  const auto tris = testing::sphere_cluster();
+  const Bvh8 bvh = build(tris);
+  unsigned seed = 20;
+  for (std::string_view kind : testing::kRayKinds) {
+    SCOPED_TRACE(std::string(kind));
+    const int hits = expect_same_hits_as_brute_force(bvh, tris, testing::rays_at(tris, kind, 2000, seed++));
+    EXPECT_GT(hits, 100);
+  }
+}
+
+TEST_P(Bvh8Build, FindsTheClosedSphereFromInsideAndNothingOutsideIt) {
   std::vector<Triangle> tris;
   append_uv_sphere(tris, {0, 0, 0}, 1.0f, 24, 48);
   const Bvh8 bvh = build(tris);
@@ -114,12 +147,15 @@ TEST(Bvh8, FindsTheClosedSphereFromInsideAndNothingOutsideIt) {
   EXPECT_FALSE(intersect_bvh8(bvh, away).hit());
 }
 
-TEST(Bvh8, EmptyInputBuildsATreeThatNothingHits) {
+TEST_P(Bvh8Build, EmptyInputBuildsATreeThatNothingHits) {
   const std::vector<Triangle> none;
   const Bvh8 bvh = build(none);
   EXPECT_FALSE(intersect_bvh8(bvh, Ray{{0, 0, 0}, 0.0f, {0, 0, 1}, kInf}).hit());
   EXPECT_FALSE(occluded_bvh8(bvh, Ray{{0, 0, 0}, 0.0f, {0, 0, 1}, kInf}));
 }
+
+INSTANTIATE_TEST_SUITE_P(Builders, Bvh8Build, ::testing::ValuesIn(kBvh2Builders),
+                         [](const auto& info) { return std::string(to_string(info.param)); });
 
 }  // namespace
 }  // namespace raybench

@@ -1,11 +1,14 @@
 // What the BVH tests share: a random triangle soup with degenerate members,
+// a small mesh with shared edges, rays of the kinds a renderer shoots at it,
 // and the brute-force closest hit every traversal is checked against.
 #pragma once
 
 #include <limits>
 #include <random>
+#include <string_view>
 #include <vector>
 
+#include "raybench/geometry/uv_sphere.h"
 #include "raybench/prim/triangle_mt.h"
 
 namespace raybench::testing {
@@ -23,6 +26,61 @@ inline std::vector<Triangle> random_soup(std::size_t n, unsigned seed) {
   tris.push_back({{1, 1, 1}, {1, 1, 1}, {2, 2, 2}});
   tris.push_back({{0, 0, 0}, {1, 1, 1}, {2, 2, 2}});
   return tris;
+}
+
+// A small real mesh: closed UV spheres with bit-identical shared edges, a
+// unit sphere and eight smaller ones of different sizes around it (the shape
+// of proc:terrain_spheres_small without its terrain); 4,000 triangles.
+inline std::vector<Triangle> sphere_cluster() {
+  std::vector<Triangle> tris;
+  append_uv_sphere(tris, {0, 0, 0}, 1.0f, 24, 48);
+  for (int i = 0; i < 8; ++i) {
+    const Vec3f c{(i & 1) ? 2.0f : -2.0f, (i & 2) ? 1.5f : -1.5f, (i & 4) ? 2.5f : -2.5f};
+    append_uv_sphere(tris, c, 0.3f + 0.1f * static_cast<float>(i), 8, 16);
+  }
+  return tris;
+}
+
+// Rays at a mesh centred near the origin, as a renderer makes them:
+//   inside   from inside the unit sphere (radius 0.5 ball), any direction;
+//   aimed    from a shell of radius 8 at an interior point of a random
+//            triangle (camera rays that hit);
+//   segment  the same, with tfar a random 0-1.2 of the distance (shadow rays,
+//            some blocked, some reaching their light);
+//   random   origins in [-6, 6]^3, any direction (mostly misses).
+inline constexpr std::string_view kRayKinds[] = {"inside", "aimed", "segment", "random"};
+
+inline std::vector<Ray> rays_at(const std::vector<Triangle>& tris, std::string_view kind, int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), bary(0.05f, 0.45f), frac(0.0f, 1.2f);
+  std::uniform_int_distribution<std::size_t> pick(0, tris.size() - 1);
+  const auto direction = [&] {
+    for (;;) {
+      const Vec3f d{u(rng), u(rng), u(rng)};
+      if (dot(d, d) > 1e-4f) return normalize(d);
+    }
+  };
+  std::vector<Ray> rays;
+  for (int i = 0; i < n; ++i) {
+    Ray r;
+    if (kind == "inside") {
+      r.org = direction() * (0.5f * std::abs(u(rng)));
+      r.dir = direction();
+    } else if (kind == "random") {
+      r.org = Vec3f{u(rng), u(rng), u(rng)} * 6.0f;
+      r.dir = direction();
+    } else {  // aimed, segment
+      r.org = direction() * 8.0f;
+      const Triangle& t = tris[pick(rng)];
+      const float b1 = bary(rng), b2 = bary(rng);
+      const Vec3f target = t.v0 * (1.0f - b1 - b2) + t.v1 * b1 + t.v2 * b2;
+      const Vec3f to = target - r.org;
+      r.dir = normalize(to);
+      if (kind == "segment") r.tfar = frac(rng) * length(to);
+    }
+    rays.push_back(r);
+  }
+  return rays;
 }
 
 // The closest hit by testing every triangle (Möller–Trumbore), last on ties.

@@ -33,8 +33,10 @@ struct Bvh2 {
     return nodes.size() * sizeof(Bvh2Node) + prim_ids.size() * sizeof(std::uint32_t);
   }
   // Surface-area-heuristic cost of the tree, relative to the root's area,
-  // with traversal cost 1 and intersection cost 1 per primitive.
-  double sah_cost() const;
+  // with traversal cost 1 and intersection cost 1 per primitive; with
+  // leaf_granularity g a leaf of n primitives costs ceil(n / g) tests, the
+  // cost a builder given the same granularity minimises (bvh8 leaves: g = 8).
+  double sah_cost(int leaf_granularity = 1) const;
 };
 
 struct Bvh2BuildOptions {
@@ -49,9 +51,25 @@ struct Bvh2BuildOptions {
   std::size_t parallel_threshold = 4096;  // subtrees at least this large are built as TBB tasks
 };
 
-// Binned-SAH build over the given triangles (top-down, centroid binning on
-// all three axes). Every triangle is placed in exactly one leaf, degenerate
-// ones included; the structure is deterministic for a given input.
+// Every builder places each triangle in exactly one leaf, degenerate ones
+// included, and keeps the depth within max_sah_depth + 32 (deeper ranges are
+// halved), so kBvh2StackSize bounds the traversal stack. The tree's shape is
+// deterministic for a given input; raybench/bvh/bvh2_builders.h selects one
+// by name.
+
+// Binned SAH, top-down, centroid binning on all three axes (bin_count bins).
 Bvh2 build_bvh2_binned_sah(std::span<const Triangle> triangles, const Bvh2BuildOptions& options = {});
+
+// Full-sweep SAH, top-down: every object split between centroid-sorted
+// neighbours on all three axes is evaluated (bin_count is ignored). The
+// quality reference for the binned builder; O(n log n) sorting up front,
+// O(n) per tree level after that.
+Bvh2 build_bvh2_sweep_sah(std::span<const Triangle> triangles, const Bvh2BuildOptions& options = {});
+
+// Linear BVH: centroids sorted along a 63-bit Morton curve, ranges split at
+// their highest differing Morton bit, bounds refitted bottom-up; ranges of at
+// most max_leaf_size become leaves when the SAH says a leaf is cheaper than
+// the best subtree (bin_count is ignored). Fast, lower quality.
+Bvh2 build_bvh2_lbvh(std::span<const Triangle> triangles, const Bvh2BuildOptions& options = {});
 
 }  // namespace raybench

@@ -35,8 +35,8 @@ struct Bvh8 {
   }
 };
 
-// Collapses `bvh2` (whose leaves hold at most 8 triangles, as
-// build_bvh2_binned_sah makes them) over `triangles`.
+// Collapses `bvh2` (whose leaves hold at most 8 triangles, as every
+// builder of bvh2_builders.h makes them with max_leaf_size 8) over `triangles`.
 Bvh8 collapse_to_bvh8(const Bvh2& bvh2, std::span<const Triangle> triangles);
 
 }  // namespace raybench

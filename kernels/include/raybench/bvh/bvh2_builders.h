@@ -1,0 +1,60 @@
+// The one list of BVH2 builders, selectable by name: backends take a builder
+// option ("bvh2:sweep", "bvh8:lbvh") parsed here, and tests run over
+// kBvh2Builders, so adding a builder is its source file, an enum value and a
+// line in each switch below.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <span>
+#include <string_view>
+
+#include "raybench/bvh/bvh2.h"
+
+namespace raybench {
+
+enum class Bvh2Builder {
+  kBinnedSah,  // the default: fast, near the sweep's quality
+  kSweepSah,   // the quality reference
+  kLbvh,       // fastest to build, lowest quality
+};
+
+inline constexpr std::array<Bvh2Builder, 3> kBvh2Builders = {Bvh2Builder::kBinnedSah, Bvh2Builder::kSweepSah,
+                                                             Bvh2Builder::kLbvh};
+
+// The option name: "binned", "sweep", "lbvh".
+constexpr std::string_view to_string(Bvh2Builder b) {
+  switch (b) {
+    case Bvh2Builder::kBinnedSah: return "binned";
+    case Bvh2Builder::kSweepSah: return "sweep";
+    case Bvh2Builder::kLbvh: return "lbvh";
+  }
+  return "?";
+}
+
+constexpr std::string_view description(Bvh2Builder b) {
+  switch (b) {
+    case Bvh2Builder::kBinnedSah: return "binned SAH (16 bins, TBB-parallel)";
+    case Bvh2Builder::kSweepSah: return "full-sweep SAH (every centroid split, the quality reference)";
+    case Bvh2Builder::kLbvh: return "LBVH (63-bit Morton codes, splits at the highest differing bit)";
+  }
+  return "?";
+}
+
+// The builder named `name` (as to_string spells it), or nothing.
+constexpr std::optional<Bvh2Builder> parse_bvh2_builder(std::string_view name) {
+  for (Bvh2Builder b : kBvh2Builders)
+    if (to_string(b) == name) return b;
+  return std::nullopt;
+}
+
+inline Bvh2 build_bvh2(std::span<const Triangle> triangles, Bvh2Builder builder, const Bvh2BuildOptions& options = {}) {
+  switch (builder) {
+    case Bvh2Builder::kSweepSah: return build_bvh2_sweep_sah(triangles, options);
+    case Bvh2Builder::kLbvh: return build_bvh2_lbvh(triangles, options);
+    case Bvh2Builder::kBinnedSah: break;
+  }
+  return build_bvh2_binned_sah(triangles, options);
+}
+
+}  // namespace raybench
