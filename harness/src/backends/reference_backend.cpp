@@ -28,7 +28,7 @@ class ReferenceBackend final : public Backend {
     return referee_ ? referee_->memory_bytes() + scene_.triangles.size() * sizeof(Triangle) : 0;
   }
 
-  // t is the float nearest the exact t; u, v are the barycentrics of the
+  // t is the float nearest the exact t (barring a double-rounding tie); u, v are the barycentrics of the
   // exact hit point, computed in double (approximate).
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
     for (std::size_t i = 0; i < rays.size(); ++i) {

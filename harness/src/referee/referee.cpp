@@ -50,7 +50,7 @@ RefereeVerdict Referee::judge(const Ray& ray) const {
     return verdict.hit() ? std::min(tmax, std::nextafter(static_cast<float>(best.t_upper), static_cast<float>(kInf))) : tmax;
   });
   if (verdict.hit()) {
-    verdict.t = exact_intersect(ray, scene_.triangles[verdict.prim]).t;  // the nearest double, for the winner only
+    verdict.t = best.t;
     verdict.ambiguous = verdict.tie || best.min_barycentric < kAmbiguityBand || near_miss_t <= best.t_upper;
   } else {
     verdict.ambiguous = near_miss_t < kInf;
