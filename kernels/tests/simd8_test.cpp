@@ -9,6 +9,8 @@
 
 #include "raybench/simd/box8.h"
 #include "raybench/simd/triangle8.h"
+#include "raybench/simd/triangle8_watertight.h"
+#include "raybench/geometry/uv_sphere.h"
 
 namespace raybench {
 namespace {
@@ -63,7 +65,8 @@ TEST(Triangle8, Avx2AnswersExactlyAsTheScalarKernel) {
   EXPECT_GT(hits, 5000);
 }
 
-TEST(Box8, Avx2AnswersExactlyAsTheScalarSlabTest) {
+template <typename BoxTest>
+void expect_box8_avx2_equals_scalar() {
   std::mt19937 rng(2);
   std::uniform_real_distribution<float> u(-1, 1);
   int hits = 0;
@@ -84,8 +87,8 @@ TEST(Box8, Avx2AnswersExactlyAsTheScalarSlabTest) {
     }
     const Slab::Precomputed pre = Slab::precompute(r);
     alignas(32) float e_simd[8], e_scalar[8];
-    const unsigned m_simd = intersect8_avx2(pre, kInf, packed, e_simd);
-    const unsigned m_scalar = intersect8_scalar(pre, kInf, packed, e_scalar);
+    const unsigned m_simd = intersect8_avx2<BoxTest>(pre, kInf, packed, e_simd);
+    const unsigned m_scalar = intersect8_scalar<BoxTest>(pre, kInf, packed, e_scalar);
     ASSERT_EQ(m_simd, m_scalar) << "ray " << i;
     for (int lane = 0; lane < 8; ++lane)
       if (m_simd >> lane & 1) {
@@ -95,7 +98,68 @@ TEST(Box8, Avx2AnswersExactlyAsTheScalarSlabTest) {
   }
   EXPECT_GT(hits, 10000);
 }
+
+TEST(Box8, Avx2AnswersExactlyAsTheScalarSlabTest) { expect_box8_avx2_equals_scalar<Slab>(); }
+TEST(Box8, Avx2AnswersExactlyAsTheScalarRobustSlabTest) { expect_box8_avx2_equals_scalar<SlabRobust>(); }
+
+TEST(Watertight8, Avx2AnswersExactlyAsTheScalarWoopTestEvenThroughEdgesAndVertices) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1, 1);
+  int hits = 0;
+  for (int i = 0; i < 20000; ++i) {
+    std::vector<Triangle> tris;
+    for (int k = 0; k < 8; ++k) tris.push_back({{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}});
+    if (i % 10 == 0) tris[3] = tris[2];                             // duplicates tie
+    if (i % 7 == 0) tris[5] = {tris[5].v0, tris[5].v0, tris[5].v1};  // degenerate
+    if (i % 5 == 0) tris[1].v0 = tris[0].v1, tris[1].v1 = tris[0].v0;  // a shared edge
+    const TriangleVertices8 packed = TriangleVertices8::pack({tris.data(), static_cast<std::size_t>(1 + i % 8)});
+    const Triangle& aim = tris[i % 8 % (1 + i % 8)];
+    const float wa = std::fabs(u(rng)), wb = i % 4 == 0 ? 0.0f : std::fabs(u(rng)) * (1.0f - wa);  // every 4th on an edge
+    const Vec3f org{u(rng) * 3, u(rng) * 3, u(rng) * 3};
+    Ray r{org, 0.0f, (i % 6 == 0 ? aim.v0 : aim.v0 + (aim.v1 - aim.v0) * wa + (aim.v2 - aim.v0) * wb) - org, kInf};
+    if (i % 13 == 0) r.dir.x = 0.0f;
+    const float tmax = i % 3 ? kInf : 2.0f;
+    const WatertightTriangle::RayData data = WatertightTriangle::precompute(r);
+    TriangleHit a{}, b{};
+    const int lane_simd = intersect8_watertight_avx2(data, tmax, packed, a);
+    const int lane_scalar = intersect8_watertight_scalar(data, tmax, packed, b);
+    ASSERT_EQ(lane_simd, lane_scalar) << "ray " << i;
+    if (lane_simd < 0) continue;
+    ++hits;
+    EXPECT_EQ(a.t, b.t);
+    EXPECT_EQ(a.u, b.u);
+    EXPECT_EQ(a.v, b.v);
+  }
+  EXPECT_GT(hits, 5000);
+}
 #endif
+
+TEST(Watertight8, NoRayFromInsideAClosedMeshSlipsBetweenPacks) {
+  // A closed UV sphere, packed 8 triangles at a time in order: rays from
+  // near the centre at its vertices and at float points of its edges must
+  // each hit some lane of some pack (Woop et al.: no cracks).
+  std::vector<Triangle> sphere;
+  append_uv_sphere(sphere, {0, 0, 0}, 1.0f, 24, 48);
+  std::vector<TriangleVertices8> packs;
+  for (std::size_t first = 0; first < sphere.size(); first += 8)
+    packs.push_back(TriangleVertices8::pack({sphere.data() + first, std::min<std::size_t>(8, sphere.size() - first)}));
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(-0.3f, 0.3f), s(0, 1);
+  int misses = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Triangle& t = sphere[static_cast<std::size_t>(i * 7919) % sphere.size()];
+    const Vec3f target = i % 2 ? t.v1 : t.v0 + (t.v2 - t.v0) * s(rng);
+    const Vec3f org{u(rng), u(rng), u(rng)};
+    const WatertightTriangle::RayData data = WatertightTriangle::precompute(Ray{org, 0.0f, target - org, kInf});
+    bool hit = false;
+    for (const TriangleVertices8& p : packs) {
+      TriangleHit h;
+      hit |= intersect8_watertight(data, kInf, p, h) >= 0;
+    }
+    misses += !hit;
+  }
+  EXPECT_EQ(misses, 0);
+}
 
 TEST(Box8, EmptyLanesAreMissed) {
   const std::vector<BBox> one{BBox{{0, 0, 0}, {1, 1, 1}}};

@@ -2,14 +2,18 @@
 // prim/aabb_slab.h (planes chosen by the direction's sign, a NaN distance
 // leaves the bound unchanged, a NaN bound misses) over boxes stored
 // structure-of-arrays, as BVH8 nodes store their children (issue 4).
+// With BoxTest = SlabRobust the exit is padded by its rounding error as in
+// prim/aabb_slab_robust.h (Ize 2013): no box the exact ray touches is missed.
 // AVX2 when the compiler targets it, else a scalar loop, same answers.
 #pragma once
 
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <type_traits>
 
 #include "raybench/prim/aabb_slab.h"
+#include "raybench/prim/aabb_slab_robust.h"
 #include "raybench/simd/triangle8.h"  // kHaveAvx2 and <immintrin.h>
 
 namespace raybench {
@@ -33,6 +37,7 @@ struct alignas(32) BBox8 {
 
 // Bit i set when box i is entered within [tnear, tmax]; entry[i] its entry
 // distance (+inf for a missed box).
+template <typename BoxTest = Slab>
 inline unsigned intersect8_scalar(const Slab::Precomputed& r, float tmax, const BBox8& b, float entry[8]) {
   unsigned mask = 0;
   for (int lane = 0; lane < 8; ++lane) {
@@ -42,7 +47,7 @@ inline unsigned intersect8_scalar(const Slab::Precomputed& r, float tmax, const 
       box.upper[a] = b.upper[a][lane];
     }
     BoxHit h;
-    const bool hit = Slab::intersect(r, box, tmax, h);
+    const bool hit = BoxTest::intersect(r, box, tmax, h);
     entry[lane] = hit ? h.t_entry : std::numeric_limits<float>::infinity();
     mask |= static_cast<unsigned>(hit) << lane;
   }
@@ -50,6 +55,7 @@ inline unsigned intersect8_scalar(const Slab::Precomputed& r, float tmax, const 
 }
 
 #if defined(__AVX2__)
+template <typename BoxTest = Slab>
 inline unsigned intersect8_avx2(const Slab::Precomputed& r, float tmax, const BBox8& b, float entry[8]) {
   __m256 t_entry = _mm256_set1_ps(r.tnear), t_exit = _mm256_set1_ps(tmax);
   for (int a = 0; a < 3; ++a) {
@@ -64,6 +70,11 @@ inline unsigned intersect8_avx2(const Slab::Precomputed& r, float tmax, const BB
     t_entry = _mm256_max_ps(t_near, t_entry);
     t_exit = _mm256_min_ps(t_far, t_exit);
   }
+  if constexpr (std::is_same_v<BoxTest, SlabRobust>) {
+    // exit + |exit| * 8u, as SlabRobust::intersect (andnot clears the sign bit).
+    const __m256 magnitude = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), t_exit);
+    t_exit = _mm256_add_ps(t_exit, _mm256_mul_ps(magnitude, _mm256_set1_ps(SlabRobust::kPad)));
+  }
   // Slab::overlaps: entry <= exit, and an entry at +inf is never reached.
   const __m256 hit = _mm256_and_ps(_mm256_cmp_ps(t_entry, t_exit, _CMP_LE_OQ),
                                    _mm256_cmp_ps(t_entry, _mm256_set1_ps(std::numeric_limits<float>::infinity()), _CMP_LT_OQ));
@@ -72,11 +83,12 @@ inline unsigned intersect8_avx2(const Slab::Precomputed& r, float tmax, const BB
 }
 #endif
 
+template <typename BoxTest = Slab>
 inline unsigned intersect8(const Slab::Precomputed& r, float tmax, const BBox8& b, float entry[8]) {
 #if defined(__AVX2__)
-  return intersect8_avx2(r, tmax, b, entry);
+  return intersect8_avx2<BoxTest>(r, tmax, b, entry);
 #else
-  return intersect8_scalar(r, tmax, b, entry);
+  return intersect8_scalar<BoxTest>(r, tmax, b, entry);
 #endif
 }
 

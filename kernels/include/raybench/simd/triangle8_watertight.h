@@ -1,0 +1,130 @@
+// One ray against 8 triangles at once with the watertight test of Woop,
+// Benthin & Wald (JCGT 2013), prim/triangle_watertight.h: the same float
+// operations in the same order per lane, so each lane answers exactly as the
+// scalar test, cracks-free on shared edges. A lane whose scaled barycentrics
+// hit exactly 0 in float (a ray through an edge or vertex) is recomputed by
+// the scalar test, which decides it in double as the paper prescribes.
+// The triangles' own vertices are stored (v1 = v0 + e1 would be rounded,
+// and neighbours must see bit-identical shared vertices), structure-of-arrays.
+// AVX2 when the compiler targets it, else a scalar loop, same answers.
+#pragma once
+
+#include <limits>
+#include <span>
+
+#include "raybench/prim/triangle_watertight.h"
+#include "raybench/simd/triangle8.h"  // kHaveAvx2 and <immintrin.h>
+
+namespace raybench {
+
+struct alignas(32) TriangleVertices8 {
+  float v[3][3][8];  // [vertex][axis][lane]
+
+  // Packs up to 8 triangles; missing lanes get NaN and never hit.
+  static TriangleVertices8 pack(std::span<const Triangle> tris) {
+    TriangleVertices8 p;
+    for (int lane = 0; lane < 8; ++lane) {
+      const bool used = lane < static_cast<int>(tris.size());
+      for (int a = 0; a < 3; ++a) {
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        p.v[0][a][lane] = used ? tris[lane].v0[a] : nan;
+        p.v[1][a][lane] = used ? tris[lane].v1[a] : nan;
+        p.v[2][a][lane] = used ? tris[lane].v2[a] : nan;
+      }
+    }
+    return p;
+  }
+
+  Triangle lane(int i) const {
+    return {{v[0][0][i], v[0][1][i], v[0][2][i]}, {v[1][0][i], v[1][1][i], v[1][2][i]}, {v[2][0][i], v[2][1][i], v[2][2][i]}};
+  }
+};
+
+// Lane by lane with the scalar test, every lane against the same tmax.
+// Returns the lane of the closest hit in (tnear, tmax], or -1; on equal t the
+// last such lane wins (as intersect8). Lowering tmax between lanes, as a
+// sequential loop would, is not the same: the test compares t_scaled with
+// tmax * det, whose rounding can reject a lane at exactly the same t.
+inline int intersect8_watertight_scalar(const WatertightTriangle::RayData& ray, float tmax, const TriangleVertices8& t,
+                                        TriangleHit& out) {
+  int best = -1;
+  for (int lane = 0; lane < 8; ++lane) {
+    TriangleHit h;
+    if (WatertightTriangle::intersect(ray, tmax, t.lane(lane), h) && (best < 0 || h.t <= out.t)) {
+      out = h;
+      best = lane;
+    }
+  }
+  return best;
+}
+
+#if defined(__AVX2__)
+inline int intersect8_watertight_avx2(const WatertightTriangle::RayData& r, float tmax, const TriangleVertices8& t,
+                                      TriangleHit& out) {
+  const __m256 sx = _mm256_set1_ps(r.sx), sy = _mm256_set1_ps(r.sy), sz = _mm256_set1_ps(r.sz);
+  const __m256 ox = _mm256_set1_ps(r.org[r.kx]), oy = _mm256_set1_ps(r.org[r.ky]), oz = _mm256_set1_ps(r.org[r.kz]);
+  // Vertex k relative to the origin, sheared: (x, y) in the ray's frame and its kz component.
+  __m256 x[3], y[3], z[3];
+  for (int k = 0; k < 3; ++k) {
+    z[k] = _mm256_sub_ps(_mm256_load_ps(t.v[k][r.kz]), oz);
+    x[k] = _mm256_sub_ps(_mm256_sub_ps(_mm256_load_ps(t.v[k][r.kx]), ox), _mm256_mul_ps(sx, z[k]));
+    y[k] = _mm256_sub_ps(_mm256_sub_ps(_mm256_load_ps(t.v[k][r.ky]), oy), _mm256_mul_ps(sy, z[k]));
+  }
+  const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
+  const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
+  const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
+  const __m256 zero = _mm256_setzero_ps();
+  // Lanes on an edge in float: the scalar test decides them in double.
+  const int exact = _mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
+                                                    _mm256_cmp_ps(w, zero, _CMP_EQ_OQ)));
+  const __m256 any_negative = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_LT_OQ), _mm256_cmp_ps(v, zero, _CMP_LT_OQ)),
+                                           _mm256_cmp_ps(w, zero, _CMP_LT_OQ));
+  const __m256 any_positive = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_GT_OQ), _mm256_cmp_ps(v, zero, _CMP_GT_OQ)),
+                                           _mm256_cmp_ps(w, zero, _CMP_GT_OQ));
+  const __m256 det = _mm256_add_ps(_mm256_add_ps(u, v), w);
+  const __m256 t_scaled = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(u, _mm256_mul_ps(sz, z[0])), _mm256_mul_ps(v, _mm256_mul_ps(sz, z[1]))),
+                                        _mm256_mul_ps(w, _mm256_mul_ps(sz, z[2])));
+  const __m256 lo = _mm256_mul_ps(_mm256_set1_ps(r.tnear), det), hi = _mm256_mul_ps(_mm256_set1_ps(tmax), det);
+  const __m256 positive = _mm256_cmp_ps(det, zero, _CMP_GT_OQ);
+  const __m256 in_positive = _mm256_and_ps(_mm256_cmp_ps(t_scaled, lo, _CMP_GT_OQ), _mm256_cmp_ps(t_scaled, hi, _CMP_LE_OQ));
+  const __m256 in_negative = _mm256_and_ps(_mm256_cmp_ps(t_scaled, lo, _CMP_LT_OQ), _mm256_cmp_ps(t_scaled, hi, _CMP_GE_OQ));
+  __m256 ok = _mm256_andnot_ps(_mm256_and_ps(any_negative, any_positive), _mm256_cmp_ps(det, zero, _CMP_NEQ_OQ));
+  ok = _mm256_and_ps(ok, _mm256_blendv_ps(in_negative, in_positive, positive));
+  const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
+  const __m256 tt = _mm256_mul_ps(t_scaled, inv_det);
+  ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(tt, _mm256_set1_ps(r.tnear), _CMP_GT_OQ),
+                                       _mm256_cmp_ps(tt, _mm256_set1_ps(tmax), _CMP_LE_OQ)));
+  int mask = _mm256_movemask_ps(ok) & ~exact;
+  if (!mask && !exact) return -1;
+  alignas(32) float ts[8], us[8], vs[8];
+  _mm256_store_ps(ts, tt);
+  _mm256_store_ps(us, _mm256_mul_ps(v, inv_det));
+  _mm256_store_ps(vs, _mm256_mul_ps(w, inv_det));
+  for (int lanes = exact; lanes; lanes &= lanes - 1) {
+    const int lane = __builtin_ctz(static_cast<unsigned>(lanes));
+    TriangleHit h;
+    if (WatertightTriangle::intersect(r, tmax, t.lane(lane), h)) {
+      ts[lane] = h.t, us[lane] = h.u, vs[lane] = h.v;
+      mask |= 1 << lane;
+    }
+  }
+  int best = -1;
+  for (; mask; mask &= mask - 1) {
+    const int lane = __builtin_ctz(static_cast<unsigned>(mask));
+    if (best < 0 || ts[lane] <= ts[best]) best = lane;  // the scalar loop's tie rule
+  }
+  if (best >= 0) out = {ts[best], us[best], vs[best]};
+  return best;
+}
+#endif
+
+inline int intersect8_watertight(const WatertightTriangle::RayData& ray, float tmax, const TriangleVertices8& t,
+                                 TriangleHit& out) {
+#if defined(__AVX2__)
+  return intersect8_watertight_avx2(ray, tmax, t, out);
+#else
+  return intersect8_watertight_scalar(ray, tmax, t, out);
+#endif
+}
+
+}  // namespace raybench
