@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -38,6 +39,10 @@ class Backend {
   virtual void build(const Scene& scene) = 0;
   // Bytes of the acceleration structure, triangle data it copied included.
   virtual std::size_t memory_bytes() const = 0;
+  // Surface-area-heuristic cost of the tree it built, relative to its root's
+  // area, for comparing builders (each backend says which cost model); NaN
+  // where it does not apply or is not known (Embree, the reference).
+  virtual double sah_cost() const { return std::numeric_limits<double>::quiet_NaN(); }
 
   // Closest hit for every ray (t, prim, u, v; a miss leaves the default Hit).
   // Untraceable rays (see is_traceable) are misses. Called concurrently on

@@ -85,4 +85,25 @@ Bvh8 collapse_to_bvh8(const Bvh2& bvh2, std::span<const Triangle> triangles) {
   return out;
 }
 
+double Bvh8::sah_cost() const {
+  if (nodes.empty()) return 0.0;
+  const auto lane_box = [](const BBox8& b, int lane) {
+    BBox box;
+    for (int a = 0; a < 3; ++a) {
+      box.lower[a] = b.lower[a][lane];
+      box.upper[a] = b.upper[a][lane];
+    }
+    return box;
+  };
+  BBox root;
+  for (int lane = 0; lane < 8; ++lane) root.extend(lane_box(nodes[0].bounds, lane));  // empty lanes add nothing
+  const double root_area = root.half_area();
+  if (!(root_area > 0.0)) return 0.0;
+  double cost = root_area;  // the root is always visited
+  for (const Bvh8Node& n : nodes)
+    for (int lane = 0; lane < 8; ++lane)
+      if (n.child[lane] != kEmptyChild) cost += lane_box(n.bounds, lane).half_area();  // an inner node or a pack
+  return cost / root_area;
+}
+
 }  // namespace raybench

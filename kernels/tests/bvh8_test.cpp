@@ -2,6 +2,7 @@
 // the BVH2 of every builder: the collapse keeps every triangle exactly once
 // under bounds that contain it, and traversal answers exactly as testing
 // every triangle does.
+#include <cmath>
 #include <random>
 #include <string>
 #include <vector>
@@ -152,6 +153,18 @@ TEST_P(Bvh8Build, EmptyInputBuildsATreeThatNothingHits) {
   const Bvh8 bvh = build(none);
   EXPECT_FALSE(intersect_bvh8(bvh, Ray{{0, 0, 0}, 0.0f, {0, 0, 1}, kInf}).hit());
   EXPECT_FALSE(occluded_bvh8(bvh, Ray{{0, 0, 0}, 0.0f, {0, 0, 1}, kInf}));
+}
+
+TEST_P(Bvh8Build, SahCostCountsNodeVisitsAndPackTests) {
+  // One triangle: the root visit, then its one pack, under a box of the root's area.
+  const std::vector<Triangle> one{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}};
+  EXPECT_DOUBLE_EQ(build(one).sah_cost(), 2.0);
+  // Many: finite, and more than the root visit alone.
+  const auto tris = random_soup(5000, 3);
+  const double cost = build(tris).sah_cost();
+  EXPECT_TRUE(std::isfinite(cost));
+  EXPECT_GT(cost, 1.0);
+  EXPECT_EQ(build({}).sah_cost(), 0.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Builders, Bvh8Build, ::testing::ValuesIn(kBvh2Builders),

@@ -1,14 +1,21 @@
-// Our binary BVH (binned SAH) with a ray-triangle test chosen by name from
+// Our binary BVH with a ray-triangle test chosen by name from
 // raybench/variants.h: "bvh2" uses the first entry, "bvh2:<test>" any of them;
 // a "robust" option ("bvh2:watertight:robust") traverses with the
 // conservative box test (SlabRobust), which never culls a box the exact ray
 // touches, so a watertight triangle test stays watertight through the tree.
+// A builder option from raybench/bvh/bvh2_builders.h ("bvh2:sweep",
+// "bvh2:watertight:robust:lbvh") picks the builder; binned SAH by default.
+// Options come in any order, each kind at most once.
+#include <algorithm>
+#include <optional>
 #include <tuple>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "backends/backend_families.h"
 #include "error.h"
+#include "raybench/bvh/bvh2_builders.h"
 #include "raybench/bvh/bvh2_traverse.h"
 #include "raybench/prim/aabb_slab_robust.h"
 #include "raybench/variants.h"
@@ -19,12 +26,12 @@ namespace {
 template <typename Test, typename BoxTest>
 class Bvh2Backend final : public Backend {
  public:
-  explicit Bvh2Backend(std::string name) : name_(std::move(name)) {}
+  Bvh2Backend(std::string name, Bvh2Builder builder) : name_(std::move(name)), builder_(builder) {}
 
   const std::string& name() const override { return name_; }
 
   void build(const Scene& scene) override {
-    bvh_ = build_bvh2_binned_sah(scene.triangles);
+    bvh_ = build_bvh2(scene.triangles, builder_);
     prepared_.clear();
     prepared_.reserve(bvh_.prim_ids.size());
     for (std::uint32_t id : bvh_.prim_ids) prepared_.push_back(Test::prepare(scene.triangles[id]));
@@ -33,6 +40,9 @@ class Bvh2Backend final : public Backend {
   std::size_t memory_bytes() const override {
     return bvh_.memory_bytes() + prepared_.size() * sizeof(typename Test::Prepared);
   }
+
+  // Bvh2::sah_cost: inner nodes and single triangle tests cost 1 each.
+  double sah_cost() const override { return bvh_.sah_cost(); }
 
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
     for (std::size_t i = 0; i < rays.size(); ++i)
@@ -46,6 +56,7 @@ class Bvh2Backend final : public Backend {
 
  private:
   std::string name_;
+  Bvh2Builder builder_;
   Bvh2 bvh_;
   std::vector<typename Test::Prepared> prepared_;
 };
@@ -54,29 +65,35 @@ class Bvh2Backend final : public Backend {
 
 std::unique_ptr<Backend> make_bvh2_backend(const std::string& name, const std::vector<std::string>& options,
                                            const BackendConfig&) {
-  std::string wanted = std::string(std::tuple_element_t<0, TriangleTests>::name);
-  bool robust = false, test_named = false;
+  std::vector<std::string_view> tests;
+  for_each_variant<TriangleTests>([&](auto test) { tests.push_back(decltype(test)::name); });
+  const std::string valid =
+      fmt::format("triangle tests: {}; builders: {}; traversal: robust", fmt::join(tests, ", "), bvh2_builder_names());
+  std::optional<std::string> test_name;
+  std::optional<Bvh2Builder> builder;
+  bool robust = false;
   for (const std::string& o : options) {
-    if (o == "robust" && !robust) {
-      robust = true;
-    } else if (!test_named && o != "robust") {
-      wanted = o;
-      test_named = true;
-    } else {
-      throw InputError("", fmt::format("backend '{}': bvh2 takes a triangle test and optionally 'robust', "
-                                       "e.g. bvh2:watertight:robust", name));
-    }
+    const std::optional<Bvh2Builder> as_builder = parse_bvh2_builder(o);
+    const bool is_test = std::find(tests.begin(), tests.end(), o) != tests.end();
+    if (o != "robust" && !as_builder && !is_test)
+      throw InputError("", fmt::format("backend '{}': unknown option '{}' ({})", name, o, valid));
+    if ((o == "robust" && robust) || (as_builder && builder) || (is_test && test_name))
+      throw InputError("", fmt::format("backend '{}': bvh2 takes a triangle test, a builder and 'robust', each at most "
+                                       "once, in any order, e.g. bvh2:watertight:robust:sweep ({})",
+                                       name, valid));
+    if (o == "robust") robust = true;
+    else if (as_builder) builder = as_builder;
+    else test_name = o;
   }
+  const std::string wanted = test_name.value_or(std::string(std::tuple_element_t<0, TriangleTests>::name));
   std::unique_ptr<Backend> made;
-  std::string known;
   for_each_variant<TriangleTests>([&](auto test) {
     using Test = decltype(test);
-    known += (known.empty() ? "" : ", ") + std::string(Test::name);
     if (Test::name != wanted) return;
-    if (robust) made = std::make_unique<Bvh2Backend<Test, SlabRobust>>(name);
-    else made = std::make_unique<Bvh2Backend<Test, Slab>>(name);
+    const Bvh2Builder b = builder.value_or(Bvh2Builder::kBinnedSah);
+    if (robust) made = std::make_unique<Bvh2Backend<Test, SlabRobust>>(name, b);
+    else made = std::make_unique<Bvh2Backend<Test, Slab>>(name, b);
   });
-  if (!made) throw InputError("", fmt::format("backend '{}': unknown triangle test '{}' (known: {})", name, wanted, known));
   return made;
 }
 
@@ -89,6 +106,13 @@ std::vector<BackendInfo> bvh2_backend_names() {
   });
   out.push_back({"bvh2:watertight:robust", "bvh2:<test>:robust traverses with the conservative box test (slab_robust)",
                  "watertight"});
+  const std::string default_accuracy(to_string(std::tuple_element_t<0, TriangleTests>::accuracy));
+  for (Bvh2Builder b : kBvh2Builders) {
+    if (b == Bvh2Builder::kBinnedSah) continue;  // the default: plain "bvh2"
+    out.push_back({"bvh2:" + std::string(to_string(b)),
+                   fmt::format("bvh2 built by {}; any bvh2 name takes :<builder>", description(b)),
+                   default_accuracy});
+  }
   return out;
 }
 

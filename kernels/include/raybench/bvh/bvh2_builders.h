@@ -7,6 +7,7 @@
 #include <array>
 #include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 
 #include "raybench/bvh/bvh2.h"
@@ -46,6 +47,13 @@ constexpr std::optional<Bvh2Builder> parse_bvh2_builder(std::string_view name) {
   for (Bvh2Builder b : kBvh2Builders)
     if (to_string(b) == name) return b;
   return std::nullopt;
+}
+
+// "binned, sweep, lbvh": for help texts and error messages.
+inline std::string bvh2_builder_names() {
+  std::string out;
+  for (Bvh2Builder b : kBvh2Builders) out += (out.empty() ? "" : ", ") + std::string(to_string(b));
+  return out;
 }
 
 inline Bvh2 build_bvh2(std::span<const Triangle> triangles, Bvh2Builder builder, const Bvh2BuildOptions& options = {}) {

@@ -33,6 +33,11 @@ struct Bvh8 {
   std::size_t memory_bytes() const {
     return nodes.size() * sizeof(Bvh8Node) + packs.size() * sizeof(Triangle8) + pack_prims.size() * sizeof(std::int32_t);
   }
+  // Surface-area-heuristic cost of the 8-wide tree, relative to the root's
+  // area: visiting a node (one 8-box test) and testing a pack (one 8-triangle
+  // test) cost 1 each, weighted by the area of the box that leads to them.
+  // Not comparable with Bvh2::sah_cost, whose units are single tests.
+  double sah_cost() const;
 };
 
 // Collapses `bvh2` (whose leaves hold at most 8 triangles, as every
