@@ -2,6 +2,7 @@
 // column list below is the schema, documented in README.md ("Results").
 #pragma once
 
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -30,9 +31,12 @@ struct ResultRow {
   std::size_t disagreements = 0;
   // Must-hit ray sets only (G01-G03): rays this backend reports as misses.
   std::optional<std::size_t> leaks;
+  // SAH cost of the backend's tree (Backend::sah_cost); NaN when not applicable.
+  double sah_cost = std::numeric_limits<double>::quiet_NaN();
 };
 
-// Column names in file order.
+// Column names in file order. Columns are only ever appended, so a reader
+// that looks columns up by name reads older files too.
 const std::vector<std::string>& result_columns();
 
 // Writes header and rows atomically (see atomic_file.h). NaN is written as an
@@ -40,7 +44,9 @@ const std::vector<std::string>& result_columns();
 void write_results_csv(const std::string& path, const std::vector<ResultRow>& rows);
 
 // Reads a results CSV into column -> value maps (tests and tools); throws
-// InputError when the header lacks a schema column.
+// InputError when the header lacks a schema column. Columns appended after
+// the first schema (sah_cost) may be missing, as in files older than them:
+// they read as the empty field, "not applicable".
 std::vector<std::map<std::string, std::string>> read_results_csv(const std::string& path);
 
 }  // namespace raybench

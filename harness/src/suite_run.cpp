@@ -207,6 +207,7 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
           row.build_ms_min = *std::min_element(build_ms.begin(), build_ms.end());
           row.build_ms_max = *std::max_element(build_ms.begin(), build_ms.end());
           row.memory_bytes = backend->memory_bytes();
+          row.sah_cost = backend->sah_cost();
           Agreement a;
           // Accuracy rows are single-run, single thread count: the first one.
           std::optional<AccuracyRow> accuracy;

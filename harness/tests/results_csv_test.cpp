@@ -64,6 +64,43 @@ TEST(ResultsCsv, RowsRoundTripAndNotApplicableIsEmpty) {
   EXPECT_EQ(rows[0].at("disagreements"), "4");
 }
 
+TEST(ResultsCsv, SahCostIsTheLastColumnAndRoundTrips) {
+  // Appended last, so the columns of older files keep their positions.
+  EXPECT_EQ(result_columns().back(), "sah_cost");
+  TempDir dir;
+  ResultRow ours;
+  ours.backend = "bvh8:sweep";
+  ours.sah_cost = 41.8125;
+  ResultRow embree;
+  embree.backend = "embree";  // sah_cost left NaN: not applicable
+  write_results_csv(dir.file("r.csv"), {ours, embree});
+  const auto rows = read_results_csv(dir.file("r.csv"));
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].at("sah_cost"), "41.8125");
+  EXPECT_EQ(rows[1].at("sah_cost"), "");
+}
+
+TEST(ResultsCsv, AFileFromBeforeTheSahCostColumnStillReads) {
+  // The header and first row of results/default-suite.csv, written before
+  // sah_cost existed.
+  TempDir dir;
+  const auto path = dir.write(
+      "old.csv",
+      "scene,triangles,rayset,query,rays,backend,threads,build_ms,build_ms_min,build_ms_max,memory_bytes,mrays_s,"
+      "mrays_s_min,mrays_s_max,reps,mrays_s_samples,ratio_to_embree,hit_rate,agree_hit,agree_prim,prim_ties,"
+      "t_relerr_max,t_relerr_p999,disagreements,leaks\n"
+      "sponza,262205,primary,intersect,262144,embree,1,109.478,101.859,139.236,17518080,2.92204,2.52573,3.24777,5,"
+      "2.92204;2.52573;3.24777;2.93679;2.76549,1,0.983913,1,1,0,0,0,0,\n");
+  const auto rows = read_results_csv(path);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].at("backend"), "embree");
+  EXPECT_EQ(rows[0].at("mrays_s"), "2.92204");
+  EXPECT_EQ(rows[0].at("sah_cost"), "");  // not in the file: not applicable
+  // An older column is still required.
+  const auto broken = dir.write("broken.csv", "scene,triangles\nbunny,1\n");
+  EXPECT_NE(testing::input_error_of([&] { read_results_csv(broken); }).find("missing column"), std::string::npos);
+}
+
 TEST(ResultsCsv, AFileWithoutTheSchemaIsRejected) {
   TempDir dir;
   const auto path = dir.write("other.csv", "name,time\nx,1\n");
