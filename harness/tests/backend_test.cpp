@@ -191,7 +191,9 @@ TEST(BackendNames, UnknownFamiliesAndOptionsAreErrorsThatSaySo) {
             std::string::npos);
   EXPECT_NE(error_of("bvh2:sweep:lbvh").find("each at most once"), std::string::npos);
   EXPECT_NE(error_of("bvh2:robust:robust").find("each at most once"), std::string::npos);
-  EXPECT_NE(error_of("bvh8:watertight").find("unknown option 'watertight'"), std::string::npos);
+  EXPECT_NO_THROW(make_backend("bvh8:watertight:robust:lbvh"));
+  EXPECT_NE(error_of("bvh8:mt_seed").find("unknown option 'mt_seed'"), std::string::npos);  // no 8-wide seed kernel
+  EXPECT_NE(error_of("bvh8:mt:watertight").find("each at most once"), std::string::npos);
   EXPECT_NE(error_of("bvh8:lbvh:sweep").find("each at most once"), std::string::npos);
   // The messages list what is valid.
   for (const char* bad : {"bvh2:magic", "bvh2:sweep:lbvh", "bvh8:magic", "bvh8:mt:mt"})

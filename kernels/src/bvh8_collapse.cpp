@@ -8,16 +8,17 @@ namespace {
 
 class Collapser {
  public:
-  Collapser(const Bvh2& bvh2, std::span<const Triangle> triangles, Bvh8& out)
-      : bvh2_(bvh2), triangles_(triangles), out_(out) {}
+  Collapser(const Bvh2& bvh2, std::span<const Triangle> triangles, Bvh8Leaves leaves, Bvh8& out)
+      : bvh2_(bvh2), triangles_(triangles), leaves_(leaves), out_(out) {}
 
   // A BVH2 leaf becomes one pack.
   std::uint32_t make_pack(const Bvh2Node& leaf) {
     if (leaf.prim_count > 8) throw std::logic_error("collapse_to_bvh8: a BVH2 leaf holds more than 8 triangles");
     Triangle tris[8];
     for (std::uint32_t i = 0; i < leaf.prim_count; ++i) tris[i] = triangles_[bvh2_.prim_ids[leaf.first_index + i]];
-    const auto index = static_cast<std::uint32_t>(out_.packs.size());
-    out_.packs.push_back(Triangle8::pack({tris, leaf.prim_count}));
+    const auto index = static_cast<std::uint32_t>(out_.pack_prims.size() / 8);
+    if (leaves_ == Bvh8Leaves::kVertices) out_.vertex_packs.push_back(TriangleVertices8::pack({tris, leaf.prim_count}));
+    else out_.packs.push_back(Triangle8::pack({tris, leaf.prim_count}));
     for (std::uint32_t i = 0; i < 8; ++i)
       out_.pack_prims.push_back(i < leaf.prim_count ? static_cast<std::int32_t>(bvh2_.prim_ids[leaf.first_index + i]) : -1);
     return Bvh8::kLeafBit | index;
@@ -61,14 +62,15 @@ class Collapser {
  private:
   const Bvh2& bvh2_;
   std::span<const Triangle> triangles_;
+  Bvh8Leaves leaves_;
   Bvh8& out_;
 };
 
 }  // namespace
 
-Bvh8 collapse_to_bvh8(const Bvh2& bvh2, std::span<const Triangle> triangles) {
+Bvh8 collapse_to_bvh8(const Bvh2& bvh2, std::span<const Triangle> triangles, Bvh8Leaves leaves) {
   Bvh8 out;
-  Collapser c(bvh2, triangles, out);
+  Collapser c(bvh2, triangles, leaves, out);
   if (triangles.empty()) return out;  // no nodes: traversal returns at once
   const Bvh2Node& root = bvh2.nodes[0];
   if (root.is_leaf()) {

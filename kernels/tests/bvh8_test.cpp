@@ -132,6 +132,60 @@ TEST_P(Bvh8Build, EveryRayKindOnAMeshMatchesBruteForce) {
   }
 }
 
+// Watertight leaves (Bvh8Leaves::kVertices), with plain and conservative
+// traversal, against the scalar watertight test on every triangle. The
+// closest t may differ by rounding where two triangles are within an ulp
+// (the test compares t_scaled with tmax * det), so t is compared to 1e-6.
+template <typename BoxTest>
+void expect_watertight_leaves_match_brute_force(const Bvh8& bvh, const std::vector<Triangle>& tris,
+                                                const std::vector<Ray>& rays) {
+  int hits = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const Hit expected = brute_force_closest<WatertightTriangle>(tris, rays[i]);
+    const Hit got = intersect_bvh8<Bvh8Watertight, BoxTest>(bvh, rays[i]);
+    ASSERT_EQ(got.hit(), expected.hit()) << "ray " << i;
+    EXPECT_EQ((occluded_bvh8<Bvh8Watertight, BoxTest>(bvh, rays[i])), expected.hit()) << "ray " << i;
+    if (!got.hit()) continue;
+    ++hits;
+    EXPECT_NEAR(got.t, expected.t, 1e-6f * expected.t) << "ray " << i;
+  }
+  EXPECT_GT(hits, 100);
+}
+
+TEST_P(Bvh8Build, WatertightLeavesMatchTheScalarWatertightTestOnEveryRayKind) {
+  const auto tris = testing::sphere_cluster();
+  Bvh2BuildOptions options;
+  options.leaf_granularity = 8;
+  const Bvh8 bvh = collapse_to_bvh8(build_bvh2(tris, GetParam(), options), tris, Bvh8Leaves::kVertices);
+  EXPECT_TRUE(bvh.packs.empty());
+  EXPECT_FALSE(bvh.vertex_packs.empty());
+  unsigned seed = 40;
+  for (std::string_view kind : testing::kRayKinds) {
+    SCOPED_TRACE(std::string(kind));
+    const std::vector<Ray> rays = testing::rays_at(tris, kind, 2000, seed++);
+    expect_watertight_leaves_match_brute_force<Slab>(bvh, tris, rays);
+    expect_watertight_leaves_match_brute_force<SlabRobust>(bvh, tris, rays);
+  }
+}
+
+TEST_P(Bvh8Build, WatertightRobustTraversalLeaksNoRayAimedAtEdgesAndVerticesFromInside) {
+  std::vector<Triangle> tris;
+  append_uv_sphere(tris, {0, 0, 0}, 1.0f, 24, 48);
+  Bvh2BuildOptions options;
+  options.leaf_granularity = 8;
+  const Bvh8 bvh = collapse_to_bvh8(build_bvh2(tris, GetParam(), options), tris, Bvh8Leaves::kVertices);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-0.5f, 0.5f), s(0, 1);
+  int leaks = 0;
+  for (int i = 0; i < 6000; ++i) {
+    const Triangle& t = tris[static_cast<std::size_t>(i) * 7919 % tris.size()];
+    const Vec3f target = i % 2 ? t.v1 : t.v0 + (t.v2 - t.v0) * s(rng);  // a vertex, or a float point of an edge
+    const Vec3f org{u(rng), u(rng), u(rng)};
+    leaks += !intersect_bvh8<Bvh8Watertight, SlabRobust>(bvh, Ray{org, 0.0f, target - org, kInf}).hit();
+  }
+  EXPECT_EQ(leaks, 0);
+}
+
 TEST_P(Bvh8Build, FindsTheClosedSphereFromInsideAndNothingOutsideIt) {
   std::vector<Triangle> tris;
   append_uv_sphere(tris, {0, 0, 0}, 1.0f, 24, 48);

@@ -83,13 +83,15 @@ inline std::vector<Ray> rays_at(const std::vector<Triangle>& tris, std::string_v
   return rays;
 }
 
-// The closest hit by testing every triangle (Möller–Trumbore), last on ties.
+// The closest hit by testing every triangle (Möller–Trumbore unless told
+// otherwise), last on ties.
+template <typename Test = MollerTrumbore>
 inline Hit brute_force_closest(const std::vector<Triangle>& tris, const Ray& ray) {
   Hit best;
   float tmax = ray.tfar;
   for (std::size_t i = 0; i < tris.size(); ++i) {
     TriangleHit h;
-    if (MollerTrumbore::intersect(ray, tmax, tris[i], h)) {
+    if (Test::intersect(ray, tmax, Test::prepare(tris[i]), h)) {
       tmax = h.t;
       best = {h.t, static_cast<std::int32_t>(i), h.u, h.v};
     }

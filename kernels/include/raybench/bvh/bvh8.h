@@ -13,6 +13,7 @@
 #include "raybench/bvh/bvh2.h"
 #include "raybench/simd/box8.h"
 #include "raybench/simd/triangle8.h"
+#include "raybench/simd/triangle8_watertight.h"
 
 namespace raybench {
 
@@ -21,17 +22,24 @@ struct alignas(32) Bvh8Node {
   std::uint32_t child[8];   // kEmptyChild, an inner node index, or kLeafBit | pack index
 };
 
+// What a leaf pack stores: Möller–Trumbore's v0, e1, e2 (Triangle8), or the
+// triangles' own vertices for the watertight test (TriangleVertices8: the
+// edges must not be rounded, or shared edges would no longer match).
+enum class Bvh8Leaves { kMollerTrumbore, kVertices };
+
 struct Bvh8 {
   static constexpr std::uint32_t kLeafBit = 0x80000000u;
   static constexpr std::uint32_t kEmptyChild = 0xffffffffu;
 
   std::vector<Bvh8Node> nodes;          // nodes[0] is the root
-  std::vector<Triangle8> packs;         // leaves: up to 8 triangles each
+  std::vector<Triangle8> packs;                 // Bvh8Leaves::kMollerTrumbore: up to 8 triangles each
+  std::vector<TriangleVertices8> vertex_packs;  // Bvh8Leaves::kVertices: the same packs as vertices
   std::vector<std::int32_t> pack_prims;  // 8 per pack: input triangle index, -1 in unused lanes
   std::size_t depth = 0;                 // levels below the root; bounds the traversal stack
 
   std::size_t memory_bytes() const {
-    return nodes.size() * sizeof(Bvh8Node) + packs.size() * sizeof(Triangle8) + pack_prims.size() * sizeof(std::int32_t);
+    return nodes.size() * sizeof(Bvh8Node) + packs.size() * sizeof(Triangle8) +
+           vertex_packs.size() * sizeof(TriangleVertices8) + pack_prims.size() * sizeof(std::int32_t);
   }
   // Surface-area-heuristic cost of the 8-wide tree, relative to the root's
   // area: visiting a node (one 8-box test) and testing a pack (one 8-triangle
@@ -42,6 +50,7 @@ struct Bvh8 {
 
 // Collapses `bvh2` (whose leaves hold at most 8 triangles, as every
 // builder of bvh2_builders.h makes them with max_leaf_size 8) over `triangles`.
-Bvh8 collapse_to_bvh8(const Bvh2& bvh2, std::span<const Triangle> triangles);
+Bvh8 collapse_to_bvh8(const Bvh2& bvh2, std::span<const Triangle> triangles,
+                      Bvh8Leaves leaves = Bvh8Leaves::kMollerTrumbore);
 
 }  // namespace raybench
