@@ -1,0 +1,150 @@
+"""Issue 4's scorecard: how our BVHs stand against Embree's best, per scene, from one results CSV.
+
+    scripts/bvh-scorecard RESULTS.csv [--out SCORECARD.md]
+
+For every scene and the primary, diffuse and shadow ray sets (one thread), it compares:
+- our best backend (every backend not named embree* or reference) with Embree's best (the faster
+  of `embree` and `embree:high`, when the run has both): target >= 1.0 per scene and ray set,
+  and >= 1.10 as a geometric mean;
+- our best watertight configuration (a backend name containing "watertight") with Embree's
+  default mode (`embree`): target >= 1.0;
+- the build time of the default builder (`bvh8`, else `bvh2`) with Embree's medium build
+  (`embree`): target <= 1.0;
+- hit/miss agreement with Embree (>= 99.99 %) and same triangle where both hit, exact ties
+  counted as agreeing (>= 99.9 %) for our best backend.
+Ratios are within the run, so they travel between machines; the run's metadata names the
+machine. Prints Markdown (or writes --out). Bad input: one line on stderr, exit 2.
+"""
+import argparse
+import math
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from report import InputError, read_meta, read_table  # noqa: E402
+
+RAYSETS = ("primary", "diffuse", "shadow")
+REQUIRED = ["scene", "rayset", "backend", "threads", "rays", "mrays_s", "build_ms", "hit_rate", "agree_hit",
+            "agree_prim", "prim_ties"]
+NUMERIC = ["threads", "rays", "mrays_s", "build_ms", "hit_rate", "agree_hit", "agree_prim", "prim_ties"]
+
+
+def is_ours(backend):
+    return not backend.startswith("embree") and backend != "reference"
+
+
+def geomean(values):
+    values = [v for v in values if v and v > 0]
+    return math.exp(sum(math.log(v) for v in values) / len(values)) if values else None
+
+
+def same_triangle(row):
+    """Where both hit: same triangle, or another at exactly the same t (a tie is not an error)."""
+    if row["agree_prim"] is None or not row["hit_rate"] or not row["rays"]:
+        return None
+    both = row["hit_rate"] * row["rays"]
+    return min(1.0, row["agree_prim"] + (row["prim_ties"] or 0) / both) if both else None
+
+
+def scorecard(rows):
+    """Per (scene, rayset): the numbers of the table; plus the overall verdicts."""
+    by = {}
+    for r in rows:
+        if r["threads"] == 1 and r["rayset"] in RAYSETS and r["mrays_s"]:
+            by.setdefault((r["scene"], r["rayset"]), {})[r["backend"]] = r
+    lines = []
+    for (scene, rayset), backends in by.items():
+        embrees = {b: r for b, r in backends.items() if b in ("embree", "embree:high")}
+        ours = {b: r for b, r in backends.items() if is_ours(b)}
+        if not embrees or not ours:
+            continue
+        embree_name, embree = max(embrees.items(), key=lambda kv: kv[1]["mrays_s"])
+        best_name, best = max(ours.items(), key=lambda kv: kv[1]["mrays_s"])
+        watertight = {b: r for b, r in ours.items() if "watertight" in b}
+        wt_name, wt = max(watertight.items(), key=lambda kv: kv[1]["mrays_s"]) if watertight else (None, None)
+        default = backends.get("embree")
+        builder = ours.get("bvh8") or ours.get("bvh2")
+        lines.append({
+            "scene": scene, "rayset": rayset,
+            "embree": embree_name, "embree_mrays": embree["mrays_s"],
+            "best": best_name, "best_mrays": best["mrays_s"], "ratio": best["mrays_s"] / embree["mrays_s"],
+            "watertight": wt_name,
+            "watertight_ratio": wt["mrays_s"] / default["mrays_s"] if wt and default else None,
+            "build_ratio": builder["build_ms"] / default["build_ms"] if builder and default and default["build_ms"] else None,
+            "agree_hit": best["agree_hit"], "same_triangle": same_triangle(best),
+        })
+    return lines
+
+
+def verdict(ok):
+    return "**met**" if ok else "**missed**"
+
+
+def render(lines, meta, source):
+    out = [f"# BVH scorecard: ours against Embree (issue 4)", "",
+           f"From `{os.path.basename(source)}`, one thread, ratios within the run."]
+    m = meta.get("machine", {}) if isinstance(meta.get("machine"), dict) else {}
+    machine = m or meta
+    facts = [f"{k}: {machine[k]}" for k in ("cpu", "cpu_model", "host", "compiler", "embree", "embree_version", "git_commit",
+                                             "commit") if k in machine]
+    if facts:
+        out += ["", "Machine and build: " + "; ".join(str(f) for f in facts) + "."]
+    out += ["", "| scene | ray set | Embree's best | Mrays/s | our best | Mrays/s | ratio | watertight / embree "
+            "| build / embree | agree hit | same tri |", "|---|---|---|---:|---|---:|---:|---:|---:|---:|---:|"]
+    def fmt(v, f, unit=""):
+        return "-" if v is None else format(v, f) + unit
+    for x in lines:
+        out.append(f"| {x['scene']} | {x['rayset']} | {x['embree']} | {x['embree_mrays']:.2f} | {x['best']} | "
+                   f"{x['best_mrays']:.2f} | {x['ratio']:.2f} | {fmt(x['watertight_ratio'], '.2f')} | "
+                   f"{fmt(x['build_ratio'], '.2f')} | {fmt(None if x['agree_hit'] is None else 100 * x['agree_hit'], '.3f', ' %')} | "
+                   f"{fmt(None if x['same_triangle'] is None else 100 * x['same_triangle'], '.2f', ' %')} |")
+    ratios = [x["ratio"] for x in lines]
+    per_rayset = {rs: geomean([x["ratio"] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
+    overall = geomean(ratios)
+    wts = [x["watertight_ratio"] for x in lines if x["watertight_ratio"] is not None]
+    builds = {x["scene"]: x["build_ratio"] for x in lines if x["build_ratio"] is not None}
+    out += ["", "Geometric mean of our best / Embree's best: " +
+            ", ".join(f"{rs} {v:.2f}" for rs, v in per_rayset.items() if v) + (f"; all {overall:.2f}." if overall else "."),
+            "", "| target | measured | |", "|---|---|---|"]
+    if ratios:
+        out.append(f"| our best ≥ 1.0 × Embree's best on every scene and ray set | min {min(ratios):.2f} | "
+                   f"{verdict(min(ratios) >= 1.0)} |")
+        out.append(f"| geometric mean ≥ 1.10 | {overall:.2f} | {verdict(overall >= 1.10)} |")
+    if wts:
+        out.append(f"| watertight ≥ 1.0 × Embree's default mode | min {min(wts):.2f} | {verdict(min(wts) >= 1.0)} |")
+    if builds:
+        out.append(f"| default build ≤ 1.0 × Embree medium | max {max(builds.values()):.2f} | "
+                   f"{verdict(max(builds.values()) <= 1.0)} |")
+    agree = [x["agree_hit"] for x in lines if x["agree_hit"] is not None]
+    same = [x["same_triangle"] for x in lines if x["same_triangle"] is not None]
+    if agree:
+        out.append(f"| hit/miss agreement ≥ 99.99 % | min {100 * min(agree):.3f} % | {verdict(min(agree) >= 0.9999)} |")
+    if same:
+        out.append(f"| same triangle ≥ 99.9 % (ties agree) | min {100 * min(same):.2f} % | {verdict(min(same) >= 0.999)} |")
+    return "\n".join(out) + "\n"
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("results", help="results CSV of a run with embree (and embree:high) beside our backends")
+    parser.add_argument("--out", help="write the Markdown here instead of stdout")
+    args = parser.parse_args(argv)
+    try:
+        rows = read_table(args.results, REQUIRED, NUMERIC)
+        lines = scorecard(rows)
+        if not lines:
+            raise InputError(args.results, "no single-thread primary, diffuse or shadow rows with both Embree and one of our backends")
+        text = render(lines, read_meta(args.results), args.results)
+    except InputError as e:
+        print(f"bvh-scorecard: error: {e}", file=sys.stderr)
+        return 2
+    if args.out:
+        with open(args.out, "w") as f:
+            f.write(text)
+    else:
+        sys.stdout.write(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
