@@ -7,6 +7,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include <tbb/parallel_invoke.h>
+
 #include "raybench/bvh/bvh2.h"
 
 namespace raybench::bvh2_build {
@@ -33,6 +35,18 @@ inline float leaf_tests(std::size_t n, int granularity) {
 inline std::uint32_t ordered_key(float f) {
   const auto bits = std::bit_cast<std::uint32_t>(f);
   return (bits & 0x80000000u) ? ~bits : bits | 0x80000000u;
+}
+
+// Builds both children of a split: as two TBB tasks when the range is large
+// enough to be worth it (Bvh2BuildOptions::parallel_threshold), else in turn.
+template <typename BuildLeft, typename BuildRight>
+void build_children(std::size_t count, std::size_t parallel_threshold, BuildLeft&& left, BuildRight&& right) {
+  if (count >= parallel_threshold) {
+    tbb::parallel_invoke(left, right);
+  } else {
+    left();
+    right();
+  }
 }
 
 }  // namespace raybench::bvh2_build

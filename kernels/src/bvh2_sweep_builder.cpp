@@ -19,7 +19,6 @@
 #include <limits>
 #include <numeric>
 
-#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
 
 #include "bvh2_build_util.h"
@@ -95,13 +94,8 @@ class SweepBuilder {
     const std::uint32_t left = next_node_.fetch_add(2);
     node.first_index = left;
     node.prim_count = 0;
-    if (count >= options_.parallel_threshold) {
-      tbb::parallel_invoke([&] { build(left, begin, middle, depth + 1); },
-                           [&] { build(left + 1, middle, end, depth + 1); });
-    } else {
-      build(left, begin, middle, depth + 1);
-      build(left + 1, middle, end, depth + 1);
-    }
+    bvh2_build::build_children(count, options_.parallel_threshold, [&] { build(left, begin, middle, depth + 1); },
+                               [&] { build(left + 1, middle, end, depth + 1); });
   }
 
   std::uint32_t node_count() const { return next_node_.load(); }
