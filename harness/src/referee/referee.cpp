@@ -2,15 +2,58 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "raybench/bvh/bvh2_traverse.h"
-#include "raybench/prim/aabb_slab_robust.h"
 #include "referee/exact_triangle.h"
 
 namespace raybench {
+namespace {
+
+// The referee's box test: SlabRobust's argument (aabb_slab_robust.h; Ize,
+// JCGT 2013) carried out in double from the float ray, so the exit is padded
+// by 8 double unit roundoffs (2^-50) instead of 8 float ones. The float
+// test's padding is 2^-21 of t: from 1e7 units away that is ~5 units, which
+// makes every box of a small mesh a candidate (and the referee 1000x slower).
+struct SlabRobustDouble {
+  struct Precomputed {
+    double org[3], inv_dir[3];
+    bool negative[3];
+    double tnear;
+  };
+  static Precomputed precompute(const Ray& ray) {
+    Precomputed p;
+    for (int a = 0; a < 3; ++a) {
+      p.org[a] = ray.org[a];
+      p.inv_dir[a] = 1.0 / static_cast<double>(ray.dir[a]);
+      p.negative[a] = std::signbit(p.inv_dir[a]);
+    }
+    p.tnear = ray.tnear;
+    return p;
+  }
+  static bool intersect(const Precomputed& r, const BBox& box, float tmax, BoxHit& out) {
+    double entry = r.tnear, exit = tmax;
+    for (int a = 0; a < 3; ++a) {
+      const double near_plane = r.negative[a] ? box.upper[a] : box.lower[a];
+      const double far_plane = r.negative[a] ? box.lower[a] : box.upper[a];
+      const double t_near = (near_plane - r.org[a]) * r.inv_dir[a];
+      const double t_far = (far_plane - r.org[a]) * r.inv_dir[a];
+      entry = t_near > entry ? t_near : entry;  // a NaN distance is ignored, as in Slab::clip
+      exit = t_far < exit ? t_far : exit;
+    }
+    exit += std::fabs(exit) * 0x1p-50;
+    if (!(entry <= exit && entry < std::numeric_limits<double>::infinity())) return false;
+    // t_entry only orders the children; it must stay finite to count as entered.
+    out = {static_cast<float>(std::min(entry, static_cast<double>(std::numeric_limits<float>::max()))),
+           static_cast<float>(exit)};
+    return true;
+  }
+};
+
+}  // namespace
 
 Referee::Referee(const Scene& scene) : scene_(scene), bvh_(build_bvh2_binned_sah(scene.triangles)) {}
 
@@ -21,7 +64,7 @@ RefereeVerdict Referee::judge(const Ray& ray) const {
   ExactTriangleHit best;
   double near_miss_t = kInf;  // the nearest t at which the ray passes within the band of a missed triangle
   const double lo = std::max(static_cast<double>(ray.tnear), 0.0);
-  traverse_bvh2<false, SlabRobust>(bvh_, ray, [&](std::uint32_t first, std::uint32_t count, float tmax) {
+  traverse_bvh2<false, SlabRobustDouble>(bvh_, ray, [&](std::uint32_t first, std::uint32_t count, float tmax) {
     for (std::uint32_t i = first; i < first + count; ++i) {
       const auto prim = static_cast<std::int32_t>(bvh_.prim_ids[i]);
       const Triangle& tri = scene_.triangles[prim];

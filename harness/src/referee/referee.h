@@ -1,7 +1,7 @@
 // The referee: ground truth for every ray of a triangle scene, as exact
 // arithmetic answers it (referee/exact_triangle.h). Candidates come from our
-// BVH2 walked with the conservative box test (SlabRobust: Ize's padding, as in
-// pbrt-v4), which never culls a box the exact ray touches; each candidate is
+// BVH2 walked with a conservative box test (SlabRobust's padding, Ize 2013, in
+// double), which never culls a box the exact ray touches; each candidate is
 // judged exactly, and the nearest exact t wins. Triangles at exactly the same
 // t are a tie: each of them is a right answer.
 #pragma once
