@@ -278,6 +278,8 @@ def fmt_short(value):
     (round numbers from 1000 and up to 0.001 in exponent form, others in full up to 1e6)."""
     if value is None or math.isnan(value):
         return DASH
+    if math.isinf(value):  # e.g. a t error where a kernel's t overflowed to infinity
+        return "\u221e" if value > 0 else "\u2212\u221e"
     round_number = float(f"{value:.2g}") == value and not 1e-3 < abs(value) < 1e3
     if value != 0 and (abs(value) >= 1e6 or abs(value) < 1e-3 or round_number):
         mantissa, exponent = f"{value:.2e}".split("e")
@@ -658,11 +660,23 @@ def pooled_words(family):
     return f", {name}={texts[values[0]]}..{texts[values[-1]]} pooled"
 
 
+def scene_family(name):
+    """The scene a sweep copy was made from: raybench names the copies of a manifest `sweep`
+    <name>@s<scale>[@o<x>_<y>_<z>] (meshes/accuracy.toml), so they group under <name>."""
+    return name.split("@", 1)[0]
+
+
 def by_scene_transform(rows):
-    """scene -> {transform -> rows}, in file order."""
-    scenes = {}
+    """scene family -> {transform -> rows}, in file order. A sweep copy at scale 1, offset 0
+    repeats rows of the scene as given (same rays, same answers): the first row is kept."""
+    scenes, seen = {}, set()
     for r in rows:
-        scenes.setdefault(r["scene"], {}).setdefault(r["transform"], []).append(r)
+        family = scene_family(r["scene"])
+        key = (family, r["transform"], r["rayset"], r["query"], r["backend"])
+        if key in seen:
+            continue
+        seen.add(key)
+        scenes.setdefault(family, {}).setdefault(r["transform"], []).append(r)
     return scenes
 
 
@@ -1252,7 +1266,7 @@ SECTION_INTROS = {
 
 def accuracy_summary(acc):
     rows = acc.rows
-    scenes = ordered(r["scene"] for r in rows)
+    scenes = ordered(scene_family(r["scene"]) for r in rows)
     backends = ordered(r["backend"] for r in rows)
     raysets = ordered(r["rayset"] for r in rows)
     lines = [f"- File: `{acc.name}`, {len(rows):,} rows (one thread each)",

@@ -139,11 +139,16 @@ def scene_accuracy_rows():
                                      "" if mrays == "" else mrays / slowdown,
                                      invalid=1, truth_hits=0, ulp_p50="", ulp_p99="",
                                      ulp_max="", false_hit=0.005 if backend == HITS_INVALID else 0))
+    # Named as raybench names a manifest sweep's copies (<name>@s<scale>[@o<x>_<y>_<z>]),
+    # including the copy at scale 1, offset 0, which repeats the scene as given.
     for scale in SWEEP_SCALES:
         for offset in SWEEP_OFFSETS:
-            for backend in ("embree", "bvh2", "bvh2:watertight"):
+            names = [f"sphere@s{scale:g}" + (f"@o{offset[0]:g}_{offset[1]:g}_{offset[2]:g}" if any(offset) else "")]
+            if scale == 1 and not any(offset):
+                names.insert(0, "sphere")
+            for backend, name in ((b, n) for n in names for b in ("embree", "bvh2", "bvh2:watertight")):
                 error = 0 if backend != "bvh2" or scale == 1 else 1e-3 * abs(math.log10(scale))
-                rows.append(accuracy_row("sphere", "closed-inside-random", backend,
+                rows.append(accuracy_row(name, "closed-inside-random", backend,
                                          speed[backend], scale=scale, offset_x=offset[0],
                                          offset_y=offset[1], offset_z=offset[2],
                                          false_miss=error, truth_hits=1))
@@ -553,6 +558,8 @@ class AccuracyDataTestCase(unittest.TestCase):
         self.assertEqual(report.fmt_rate(1e-7), "1e-5 %")  # never a rounded "0"
         self.assertEqual(report.fmt_rate(0.9999999), "99.99999 %")  # never a rounded "100"
         self.assertEqual(report.fmt_rate(1), "100 %")
+        # A kernel whose t overflowed has an infinite ulp error: shown, not a crash.
+        self.assertEqual(report.fmt_ulp(float("inf")), "\u221e")
 
 
 class BadInputTestCase(unittest.TestCase):
