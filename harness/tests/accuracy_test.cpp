@@ -229,7 +229,9 @@ raysets = ["shared-edge-aimed"]
     if (r.backend == "reference") {
       EXPECT_EQ(r.error_rate(), 0.0) << r.scene << " " << r.rayset;
       EXPECT_EQ(r.accuracy_class, "exact");
-      if (!std::isnan(r.ulp_max)) EXPECT_LE(r.ulp_max, 0.5) << "the float nearest the exact t";
+      if (!std::isnan(r.ulp_max)) {
+        EXPECT_LE(r.ulp_max, 0.5) << "the float nearest the exact t";
+      }
     }
   }
 }

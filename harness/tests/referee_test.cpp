@@ -176,7 +176,9 @@ TEST(Referee, NeverLeaksThroughAClosedMeshFromInside) {
     EXPECT_EQ(misses, 0u) << to_string(kind);
     // d = target - o is rounded, so an aimed ray passes exactly through its
     // vertex or edge only sometimes, and within rounding of it always.
-    if (kind == RaySetKind::kVertexAimed) EXPECT_GT(ties, 0u) << "some pass exactly through the vertex";
+    if (kind == RaySetKind::kVertexAimed) {
+      EXPECT_GT(ties, 0u) << "some pass exactly through the vertex";
+    }
     if (kind != RaySetKind::kClosedInsideRandom) {
       EXPECT_GT(ambiguous, rays.size() * 9 / 10) << to_string(kind);
     } else {

@@ -48,10 +48,12 @@ struct alignas(32) TriangleVertices8 {
 inline int intersect8_watertight_scalar(const WatertightTriangle::RayData& ray, float tmax, const TriangleVertices8& t,
                                         TriangleHit& out) {
   int best = -1;
+  float best_t = 0.0f;
   for (int lane = 0; lane < 8; ++lane) {
-    TriangleHit h;
-    if (WatertightTriangle::intersect(ray, tmax, t.lane(lane), h) && (best < 0 || h.t <= out.t)) {
+    TriangleHit h{};
+    if (WatertightTriangle::intersect(ray, tmax, t.lane(lane), h) && (best < 0 || h.t <= best_t)) {
       out = h;
+      best_t = h.t;
       best = lane;
     }
   }
