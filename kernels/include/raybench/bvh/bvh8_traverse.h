@@ -78,6 +78,19 @@ inline Hit traverse_bvh8(const Bvh8& bvh, const Ray& ray) {
     const Bvh8Node& node = bvh.nodes[e.ref];
     alignas(32) float entry[8];
     unsigned mask = intersect8<BoxTest>(r, tmax, node.bounds, entry);
+    if constexpr (AnyHit) {
+      // Any hit will do: no ordering by distance, but leaves go on top, so
+      // they are tested before any inner node is opened (a hit ends the walk).
+      for (unsigned inner = mask; inner; inner &= inner - 1) {
+        const int lane = __builtin_ctz(inner);
+        if (!(node.child[lane] & Bvh8::kLeafBit)) stack[top++] = {node.child[lane], entry[lane]};
+      }
+      for (unsigned leaves = mask; leaves; leaves &= leaves - 1) {
+        const int lane = __builtin_ctz(leaves);
+        if (node.child[lane] & Bvh8::kLeafBit) stack[top++] = {node.child[lane], entry[lane]};
+      }
+      continue;
+    }
     // Push the hit children farthest first, so the nearest is popped next
     // (insertion into a small sorted run on top of the stack).
     const int base = top;
