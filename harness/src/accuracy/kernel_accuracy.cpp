@@ -73,15 +73,21 @@ Truth triangle_truth(const Ray& ray, const Triangle& tri) {
 
 // --- The families: ray sets, referee, and how a variant is called -------------
 
-struct BoxFamily {
-  using Prim = BBox;
-  using Variants = BoxTests;
-  static std::vector<PrimRaySet<Prim>> raysets(std::size_t n, std::uint64_t seed) { return box_raysets(n, seed); }
+// What the box, OBB and sphere families share: the kernels take the primitive
+// as it is, and the exact referee of referee/exact_primitives.h judges it.
+template <typename P>
+struct AnalyticFamily {
+  using Prim = P;
   static Truth truth(const Ray& r, const Prim& p) { return from_exact(r, exact_intersect(r, p)); }
   template <typename V>
   using Prepared = Prim;
   template <typename V>
   static Prim prepare(const Prim& p) { return p; }
+};
+
+struct BoxFamily : AnalyticFamily<BBox> {
+  using Variants = BoxTests;
+  static std::vector<PrimRaySet<Prim>> raysets(std::size_t n, std::uint64_t seed) { return box_raysets(n, seed); }
   template <typename V>
   RAYBENCH_INLINE static Answer answer(const Ray& r, const Prim& box) {
     BoxHit h{kNaN, kNaN};
@@ -92,15 +98,9 @@ struct BoxFamily {
   }
 };
 
-struct ObbFamily {
-  using Prim = OrientedBox;
+struct ObbFamily : AnalyticFamily<OrientedBox> {
   using Variants = ObbTests;
   static std::vector<PrimRaySet<Prim>> raysets(std::size_t n, std::uint64_t seed) { return obb_raysets(n, seed); }
-  static Truth truth(const Ray& r, const Prim& p) { return from_exact(r, exact_intersect(r, p)); }
-  template <typename V>
-  using Prepared = Prim;
-  template <typename V>
-  static Prim prepare(const Prim& p) { return p; }
   template <typename V>
   RAYBENCH_INLINE static Answer answer(const Ray& r, const Prim& box) {
     BoxHit h{kNaN, kNaN};
@@ -111,15 +111,9 @@ struct ObbFamily {
   }
 };
 
-struct SphereFamily {
-  using Prim = Sphere;
+struct SphereFamily : AnalyticFamily<Sphere> {
   using Variants = SphereTests;
   static std::vector<PrimRaySet<Prim>> raysets(std::size_t n, std::uint64_t seed) { return sphere_raysets(n, seed); }
-  static Truth truth(const Ray& r, const Prim& p) { return from_exact(r, exact_intersect(r, p)); }
-  template <typename V>
-  using Prepared = Prim;
-  template <typename V>
-  static Prim prepare(const Prim& p) { return p; }
   template <typename V>
   RAYBENCH_INLINE static Answer answer(const Ray& r, const Prim& s) {
     SphereHit h{kNaN, kNaN};
