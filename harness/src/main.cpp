@@ -160,6 +160,10 @@ int run(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 24));
   accuracy_kernels_cmd->add_option("--seed", kernel_accuracy_options.seed, "Ray generation seed")->capture_default_str();
+  kernel_accuracy_options.rays_dir = kDefaultRaysDir;
+  accuracy_kernels_cmd->add_option("--rays-dir", kernel_accuracy_options.rays_dir,
+                                   "Where each ray set is stored as .npy (rays, and the primitive of each ray); '' for nowhere")
+      ->capture_default_str();
 
   // raybench compare
   std::string compare_base, compare_current, compare_format = "table", compare_out;

@@ -17,6 +17,7 @@
 
 #include "accuracy/prim_raysets.h"
 #include "raybench/variants.h"
+#include "npy.h"
 #include "test_util.h"
 
 namespace raybench {
@@ -77,6 +78,29 @@ TEST(KernelAccuracy, OneRowPerRaySetAndVariantInTheSchema) {
   }
   EXPECT_EQ(row("prim:sphere", "far-small-sphere:D=1e3", "sphere_seed").accuracy_class, "epsilon");
   EXPECT_EQ(row("prim:box", "control-random", "slab_robust").accuracy_class, "conservative");
+}
+
+TEST(KernelAccuracy, RaySetsAreStoredAsNpyLikeEveryRaySet) {
+  testing::TempDir dir;
+  KernelAccuracyOptions o;
+  o.rays = 64;
+  o.repetitions = 1;
+  o.filter = "prim:sphere/origin-inside/kernel:sphere_seed";
+  o.rays_dir = dir.file("rays");
+  run_kernel_accuracy(o);
+  const std::string base = dir.file("rays/prim_sphere.origin-inside.n64.seed1");
+  const std::vector<Ray> rays = read_ray_file(base + ".rays.npy");
+  const std::vector<PrimRaySet<Sphere>> sets = sphere_raysets(64, 1);
+  const auto set = std::find_if(sets.begin(), sets.end(), [](const auto& s) { return s.rayset == "origin-inside"; });
+  ASSERT_NE(set, sets.end());
+  ASSERT_EQ(rays.size(), set->rays.size());
+  EXPECT_EQ(std::memcmp(rays.data(), set->rays.data(), rays.size() * sizeof(Ray)), 0);
+  std::size_t n = 0, columns = 0;
+  const std::vector<double> prims = read_npy_f64(base + ".prims.npy", n, columns);
+  ASSERT_EQ(n, 64u);
+  ASSERT_EQ(columns, 4u);  // centre xyz, radius
+  EXPECT_EQ(static_cast<float>(prims[3]), set->prims[0].radius);
+  EXPECT_EQ(static_cast<float>(prims[4 * 63]), set->prims[63].center.x);
 }
 
 // --- G15: every seed hits invalid rays; no fixed variant does -----------------

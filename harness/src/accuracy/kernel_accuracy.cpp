@@ -1,9 +1,11 @@
 #include "accuracy/kernel_accuracy.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cfloat>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <iostream>
 #include <limits>
 
@@ -15,6 +17,7 @@
 #include "error.h"
 #include "gbench.h"
 #include "metadata.h"
+#include "npy.h"
 #include "raybench/math/inline.h"
 #include "raybench/variants.h"
 #include "referee/exact_primitives.h"
@@ -246,6 +249,26 @@ std::string row_key(const std::string& scene, const std::string& rayset, std::st
   return fmt::format("{}/{}/kernel:{}", scene, rayset, variant);
 }
 
+// Stores a set as the header of KernelAccuracyOptions::rays_dir says; the
+// file name keeps only [A-Za-z0-9._-] of the set's name.
+template <typename Prim>
+void store(const PrimRaySet<Prim>& set, const KernelAccuracyOptions& options) {
+  static_assert(sizeof(Prim) % sizeof(float) == 0, "a primitive is a plain record of floats");
+  constexpr std::size_t kFloats = sizeof(Prim) / sizeof(float);
+  std::string name = fmt::format("{}.{}.n{}.seed{}", set.scene, set.rayset, set.rays.size(), options.seed);
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-' && c != '_') c = '_';
+  const std::string base = options.rays_dir + "/" + name;
+  write_ray_file(base + ".rays.npy", set.rays);
+  std::vector<double> prims(set.prims.size() * kFloats);
+  for (std::size_t i = 0; i < set.prims.size(); ++i) {
+    float f[kFloats];
+    std::memcpy(f, &set.prims[i], sizeof(Prim));
+    for (std::size_t k = 0; k < kFloats; ++k) prims[i * kFloats + k] = f[k];
+  }
+  write_npy_f64(base + ".prims.npy", prims, set.prims.size(), kFloats);
+}
+
 template <typename Family>
 void run_family(const KernelAccuracyOptions& options, std::vector<AccuracyRow>& rows) {
   for (const auto& set : Family::raysets(options.rays, options.seed)) {
@@ -256,6 +279,7 @@ void run_family(const KernelAccuracyOptions& options, std::vector<AccuracyRow>& 
     for_each_variant<typename Family::Variants>([&](auto v) { any = any || wanted(decltype(v)::name); });
     if (!any) continue;
     std::cerr << fmt::format("raybench: {} {}: judging {} rays\n", set.scene, set.rayset, set.rays.size());
+    if (!options.rays_dir.empty()) store(set, options);
     std::vector<Truth> truth(set.rays.size());
     for (std::size_t i = 0; i < set.rays.size(); ++i) truth[i] = Family::truth(set.rays[i], set.prims[i]);
     for_each_variant<typename Family::Variants>([&](auto v) {

@@ -51,6 +51,11 @@ struct KernelAccuracyOptions {
   std::uint64_t seed = 1;
   int repetitions = 5;
   std::string command_line;
+  // When set, every ray set judged is stored here as two .npy files, like
+  // every raybench ray set: <scene>.<rayset>.n<N>.seed<S>.rays.npy (float32,
+  // (N, 8), the ray-file format) and ….prims.npy (float64, (N, K): the
+  // primitive each ray is tested against, its K floats in declaration order).
+  std::string rays_dir;
 };
 
 // Builds the ray sets, judges every ray, times every variant; writes the CSV
