@@ -405,52 +405,45 @@ std::pair<Ray, Frame> on_surface_ray(Rng& rng, std::size_t i, bool outward) {
 
 }  // namespace
 
-std::vector<PrimRaySet<BBox>> box_raysets(std::size_t n, std::uint64_t seed) {
-  const std::string scene = "prim:box";
-  std::vector<PrimRaySet<BBox>> sets;
-  const std::uint64_t pairs = hash_string("prim:box/axis-parallel-signed-zero/pairs");
-  sets.push_back(make_set<BBox>(scene, "axis-parallel-signed-zero", n, seed, [&](Rng&, std::size_t i) {
+namespace {
+
+// The box and the OBB get the same sets, the primitive made from the same
+// frames: G09 (twins differing only in the sign of zero; exact-float faces,
+// signed-permutation axes), G10 origin-inside (uniform in the box with a 10 %
+// margin, uniform directions), G11 on the surface outward and inward, and the
+// common sets.
+template <typename Prim>
+std::vector<PrimRaySet<Prim>> slab_raysets(const std::string& scene, std::size_t n, std::uint64_t seed,
+                                           Prim (Frame::*from_frame)() const, Sample<Prim> (*random)(Rng&)) {
+  std::vector<PrimRaySet<Prim>> sets;
+  const std::uint64_t pairs = hash_string((scene + "/axis-parallel-signed-zero/pairs").c_str());
+  sets.push_back(make_set<Prim>(scene, "axis-parallel-signed-zero", n, seed, [&](Rng&, std::size_t i) {
     Rng pair_rng(seed, pairs, i / 2);
     auto [ray, frame] = signed_zero_ray(pair_rng, i % 2 == 1);
-    return std::pair{ray, frame.bbox()};
+    return std::pair{ray, (frame.*from_frame)()};
   }));
-  // G10 origin-inside: uniform in the box (10 % margin), uniform directions.
-  sets.push_back(make_set<BBox>(scene, "origin-inside", n, seed, [](Rng& rng, std::size_t) {
-    const Sample<BBox> s = random_box(rng);
+  sets.push_back(make_set<Prim>(scene, "origin-inside", n, seed, [&](Rng& rng, std::size_t) {
+    const Sample<Prim> s = random(rng);
     return std::pair{make_ray(to_f(s.inside(rng)), to_f(unit_vector(rng))), s.prim};
   }));
   for (const bool outward : {true, false})
-    sets.push_back(make_set<BBox>(scene, outward ? "origin-on-surface:outward" : "origin-on-surface:inward", n, seed,
+    sets.push_back(make_set<Prim>(scene, outward ? "origin-on-surface:outward" : "origin-on-surface:inward", n, seed,
                                   [&](Rng& rng, std::size_t i) {
                                     auto [ray, frame] = on_surface_ray(rng, i, outward);
-                                    return std::pair{ray, frame.bbox()};
+                                    return std::pair{ray, (frame.*from_frame)()};
                                   }));
-  add_common_sets<BBox>(sets, scene, n, seed, random_box);
+  add_common_sets<Prim>(sets, scene, n, seed, random);
   return sets;
 }
 
+}  // namespace
+
+std::vector<PrimRaySet<BBox>> box_raysets(std::size_t n, std::uint64_t seed) {
+  return slab_raysets<BBox>("prim:box", n, seed, &Frame::bbox, random_box);
+}
+
 std::vector<PrimRaySet<OrientedBox>> obb_raysets(std::size_t n, std::uint64_t seed) {
-  const std::string scene = "prim:obb";
-  std::vector<PrimRaySet<OrientedBox>> sets;
-  // G09 and G11 need faces that are exact floats: signed-permutation axes.
-  const std::uint64_t pairs = hash_string("prim:obb/axis-parallel-signed-zero/pairs");
-  sets.push_back(make_set<OrientedBox>(scene, "axis-parallel-signed-zero", n, seed, [&](Rng&, std::size_t i) {
-    Rng pair_rng(seed, pairs, i / 2);
-    auto [ray, frame] = signed_zero_ray(pair_rng, i % 2 == 1);
-    return std::pair{ray, frame.obb()};
-  }));
-  sets.push_back(make_set<OrientedBox>(scene, "origin-inside", n, seed, [](Rng& rng, std::size_t) {
-    const Sample<OrientedBox> s = random_obb(rng);
-    return std::pair{make_ray(to_f(s.inside(rng)), to_f(unit_vector(rng))), s.prim};
-  }));
-  for (const bool outward : {true, false})
-    sets.push_back(make_set<OrientedBox>(scene, outward ? "origin-on-surface:outward" : "origin-on-surface:inward", n,
-                                         seed, [&](Rng& rng, std::size_t i) {
-                                           auto [ray, frame] = on_surface_ray(rng, i, outward);
-                                           return std::pair{ray, frame.obb()};
-                                         }));
-  add_common_sets<OrientedBox>(sets, scene, n, seed, random_obb);
-  return sets;
+  return slab_raysets<OrientedBox>("prim:obb", n, seed, &Frame::obb, random_obb);
 }
 
 std::vector<PrimRaySet<Sphere>> sphere_raysets(std::size_t n, std::uint64_t seed) {
