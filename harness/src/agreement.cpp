@@ -2,9 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace raybench {
+
+double nearest_rank_percentile(std::vector<double>& values, double p) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto rank = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(p * values.size()))) - 1;
+  std::nth_element(values.begin(), values.begin() + rank, values.end());
+  return values[rank];
+}
 
 Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference) {
   Agreement a;
@@ -25,10 +33,7 @@ Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> referen
     relerr.push_back(r.t != 0.0f ? diff / std::fabs(static_cast<double>(r.t)) : diff);
   }
   if (!relerr.empty()) {
-    // Nearest-rank percentile: the smallest value with at least 99.9 % at or below it.
-    const auto rank = static_cast<std::size_t>(std::ceil(0.999 * relerr.size())) - 1;
-    std::nth_element(relerr.begin(), relerr.begin() + rank, relerr.end());
-    a.t_relerr_p999 = relerr[rank];
+    a.t_relerr_p999 = nearest_rank_percentile(relerr, 0.999);
     a.t_relerr_max = *std::max_element(relerr.begin(), relerr.end());
   }
   return a;

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "raybench/math/ray.h"
 
@@ -26,6 +27,10 @@ struct Agreement {
   // Rays that disagree on hit/miss, plus rays where both hit different triangles.
   std::size_t disagreements() const { return (rays - same_hit) + (both_hit - same_prim); }
 };
+
+// The nearest-rank p-th percentile (0 < p <= 1): the smallest value with at
+// least p of the values at or below it; NaN for none. Reorders `values`.
+double nearest_rank_percentile(std::vector<double>& values, double p);
 
 Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference);
 Agreement compare_occlusion(std::span<const std::uint8_t> tested, std::span<const std::uint8_t> reference);

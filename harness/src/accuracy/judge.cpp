@@ -5,17 +5,12 @@
 #include <limits>
 #include <vector>
 
+#include "agreement.h"
+
 namespace raybench {
 namespace {
 
 double fraction(std::size_t count, std::size_t total) { return total ? static_cast<double>(count) / total : 0.0; }
-
-// The nearest-rank percentile of a sorted sample.
-double percentile(const std::vector<double>& sorted, double p) {
-  if (sorted.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const auto rank = static_cast<std::size_t>(std::ceil(p * sorted.size()));
-  return sorted[std::min(sorted.size() - 1, rank == 0 ? 0 : rank - 1)];
-}
 
 // The columns every query shares.
 void count_truth(std::span<const Ray> rays, std::span<const RefereeVerdict> truth, AccuracyRow& row) {
@@ -65,10 +60,9 @@ void judge_hits(const Referee& referee, std::span<const Ray> rays, std::span<con
   row.false_hit = fraction(false_hit, rays.size());
   row.wrong_prim = fraction(wrong_prim, rays.size());
   row.self_hits = sources.empty() ? std::numeric_limits<double>::quiet_NaN() : fraction(self_hits, rays.size());
-  std::sort(ulps.begin(), ulps.end());
-  row.ulp_p50 = percentile(ulps, 0.5);
-  row.ulp_p99 = percentile(ulps, 0.99);
-  row.ulp_max = ulps.empty() ? std::numeric_limits<double>::quiet_NaN() : ulps.back();
+  row.ulp_p50 = nearest_rank_percentile(ulps, 0.5);
+  row.ulp_p99 = nearest_rank_percentile(ulps, 0.99);
+  row.ulp_max = ulps.empty() ? std::numeric_limits<double>::quiet_NaN() : *std::max_element(ulps.begin(), ulps.end());
 }
 
 void judge_occlusion(std::span<const Ray> rays, std::span<const RefereeVerdict> truth,
