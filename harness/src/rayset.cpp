@@ -51,6 +51,13 @@ void basis(const Eigen::Vector3d& n, Eigen::Vector3d& b1, Eigen::Vector3d& b2) {
 
 std::uint64_t stream_of(RaySetKind kind) { return hash_string(to_string(kind).c_str()); }
 
+// A uniform direction on the unit sphere (uniform z and azimuth: Archimedes).
+Eigen::Vector3d uniform_direction(Rng& rng) {
+  const double z = 2.0 * rng.next_double() - 1.0, phi = 2.0 * std::numbers::pi * rng.next_double();
+  const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
+  return {s * std::cos(phi), z, s * std::sin(phi)};
+}
+
 }  // namespace
 
 constexpr RaySetKind kAllKinds[] = {
@@ -265,9 +272,7 @@ std::vector<Ray> RayGenerator::uniform(const RaySetSpec& spec) const {
   const double radius = 1.5 * 0.5 * extent.norm();
   tbb::parallel_for(std::size_t{0}, spec.count, [&](std::size_t i) {
     Rng rng(spec.seed, stream_of(RaySetKind::kUniform), i);
-    const double z = 2.0 * rng.next_double() - 1.0, phi = 2.0 * std::numbers::pi * rng.next_double();
-    const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const Eigen::Vector3d origin = center + radius * Eigen::Vector3d(s * std::cos(phi), z, s * std::sin(phi));
+    const Eigen::Vector3d origin = center + radius * uniform_direction(rng);
     const Eigen::Vector3d target = lower + Eigen::Vector3d(rng.next_double(), rng.next_double(), rng.next_double()).cwiseProduct(extent);
     Ray r;
     r.org = to_vec(origin);
@@ -291,16 +296,12 @@ std::vector<Ray> RayGenerator::must_hit(const RaySetSpec& spec) const {
   tbb::parallel_for(std::size_t{0}, spec.count, [&](std::size_t i) {
     Rng rng(spec.seed, stream_of(spec.kind), i);
     // Uniform in the ball: a uniform direction times radius * cbrt(u).
-    const double z = 2.0 * rng.next_double() - 1.0, phi = 2.0 * std::numbers::pi * rng.next_double();
-    const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const Eigen::Vector3d unit(s * std::cos(phi), z, s * std::sin(phi));
+    const Eigen::Vector3d unit = uniform_direction(rng);
     const Eigen::Vector3d origin = to_eigen(spec.inside->center) + unit * (spec.inside->radius * std::cbrt(rng.next_double()));
     Ray r;
     r.org = to_vec(origin);
     if (spec.kind == RaySetKind::kClosedInsideRandom) {
-      const double z2 = 2.0 * rng.next_double() - 1.0, phi2 = 2.0 * std::numbers::pi * rng.next_double();
-      const double s2 = std::sqrt(std::max(0.0, 1.0 - z2 * z2));
-      r.dir = to_vec(Eigen::Vector3d(s2 * std::cos(phi2), z2, s2 * std::sin(phi2)));
+      r.dir = to_vec(uniform_direction(rng));
     } else {
       const Triangle& t = scene_.triangles[rng.next_u64() % triangles];
       const Vec3f corners[3] = {t.v0, t.v1, t.v2};
@@ -319,12 +320,6 @@ std::vector<Ray> RayGenerator::must_hit(const RaySetSpec& spec) const {
 
 
 namespace {
-
-Eigen::Vector3d uniform_direction(Rng& rng) {
-  const double z = 2.0 * rng.next_double() - 1.0, phi = 2.0 * std::numbers::pi * rng.next_double();
-  const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
-  return {s * std::cos(phi), z, s * std::sin(phi)};
-}
 
 // A point of the triangle with every barycentric coordinate >= margin.
 Eigen::Vector3d interior_point(const Triangle& t, Rng& rng, double margin) {
