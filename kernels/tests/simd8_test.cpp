@@ -35,23 +35,45 @@ TEST(Triangle8, ReturnsTheClosestLane) {
 }
 
 #if defined(__AVX2__)
+// Case i of the AVX2-against-scalar tests: 1 to 8 random triangles (every
+// 10th case with two equal ones, every 7th with a degenerate one) and a ray
+// aimed at a point of one of them, so most rays exercise hits; every 13th
+// ray has a zero direction component, every third case a finite tmax. With
+// edge_cases, every 5th case has two triangles sharing an edge and rays aim
+// at an edge (every 4th) or a vertex (every 6th).
+struct RandomPack {
+  std::vector<Triangle> tris;
+  Ray ray;
+  float tmax;
+};
+
+RandomPack random_pack(std::mt19937& rng, int i, bool edge_cases) {
+  std::uniform_real_distribution<float> u(-1, 1);
+  RandomPack c;
+  for (int k = 0; k < 8; ++k) c.tris.push_back({{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}});
+  auto& tris = c.tris;
+  if (i % 10 == 0) tris[3] = tris[2];                                // duplicates tie
+  if (i % 7 == 0) tris[5] = {tris[5].v0, tris[5].v0, tris[5].v1};     // degenerate
+  if (edge_cases && i % 5 == 0) tris[1].v0 = tris[0].v1, tris[1].v1 = tris[0].v0;  // a shared edge
+  tris.resize(static_cast<std::size_t>(1 + i % 8));
+  const Triangle aim = tris[static_cast<std::size_t>(i % 8 % (1 + i % 8))];
+  const float wa = std::fabs(u(rng)), wb = edge_cases && i % 4 == 0 ? 0.0f : std::fabs(u(rng)) * (1.0f - wa);
+  const Vec3f org{u(rng) * 3, u(rng) * 3, u(rng) * 3};
+  const Vec3f target = edge_cases && i % 6 == 0 ? aim.v0 : aim.v0 + (aim.v1 - aim.v0) * wa + (aim.v2 - aim.v0) * wb;
+  c.ray = Ray{org, 0.0f, target - org, kInf};
+  if (i % 13 == 0) c.ray.dir.x = 0.0f;
+  c.tmax = i % 3 ? kInf : 2.0f;
+  return c;
+}
+
 TEST(Triangle8, Avx2AnswersExactlyAsTheScalarKernel) {
   std::mt19937 rng(1);
-  std::uniform_real_distribution<float> u(-1, 1);
   int hits = 0;
   for (int i = 0; i < 20000; ++i) {
-    std::vector<Triangle> tris;
-    for (int k = 0; k < 8; ++k) tris.push_back({{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}});
-    if (i % 10 == 0) tris[3] = tris[2];                               // duplicates tie
-    if (i % 7 == 0) tris[5] = {tris[5].v0, tris[5].v0, tris[5].v1};    // degenerate
-    const Triangle8 packed = Triangle8::pack({tris.data(), static_cast<std::size_t>(1 + i % 8)});
-    // Aimed at a point of one lane's triangle, so most rays exercise hits.
-    const Triangle& aim = tris[i % 8 % (1 + i % 8)];
-    const float wa = std::fabs(u(rng)), wb = std::fabs(u(rng)) * (1.0f - wa);
-    const Vec3f org{u(rng) * 3, u(rng) * 3, u(rng) * 3};
-    Ray r{org, 0.0f, aim.v0 + (aim.v1 - aim.v0) * wa + (aim.v2 - aim.v0) * wb - org, kInf};
-    if (i % 13 == 0) r.dir.x = 0.0f;
-    const float tmax = i % 3 ? kInf : 2.0f;
+    const RandomPack c = random_pack(rng, i, false);
+    const Triangle8 packed = Triangle8::pack(c.tris);
+    const Ray& r = c.ray;
+    const float tmax = c.tmax;
     TriangleHit a{}, b{};
     const int lane_simd = intersect8_avx2(r, tmax, packed, a);
     const int lane_scalar = intersect8_scalar(r, tmax, packed, b);
@@ -104,21 +126,12 @@ TEST(Box8, Avx2AnswersExactlyAsTheScalarRobustSlabTest) { expect_box8_avx2_equal
 
 TEST(Watertight8, Avx2AnswersExactlyAsTheScalarWoopTestEvenThroughEdgesAndVertices) {
   std::mt19937 rng(3);
-  std::uniform_real_distribution<float> u(-1, 1);
   int hits = 0;
   for (int i = 0; i < 20000; ++i) {
-    std::vector<Triangle> tris;
-    for (int k = 0; k < 8; ++k) tris.push_back({{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}});
-    if (i % 10 == 0) tris[3] = tris[2];                             // duplicates tie
-    if (i % 7 == 0) tris[5] = {tris[5].v0, tris[5].v0, tris[5].v1};  // degenerate
-    if (i % 5 == 0) tris[1].v0 = tris[0].v1, tris[1].v1 = tris[0].v0;  // a shared edge
-    const TriangleVertices8 packed = TriangleVertices8::pack({tris.data(), static_cast<std::size_t>(1 + i % 8)});
-    const Triangle& aim = tris[i % 8 % (1 + i % 8)];
-    const float wa = std::fabs(u(rng)), wb = i % 4 == 0 ? 0.0f : std::fabs(u(rng)) * (1.0f - wa);  // every 4th on an edge
-    const Vec3f org{u(rng) * 3, u(rng) * 3, u(rng) * 3};
-    Ray r{org, 0.0f, (i % 6 == 0 ? aim.v0 : aim.v0 + (aim.v1 - aim.v0) * wa + (aim.v2 - aim.v0) * wb) - org, kInf};
-    if (i % 13 == 0) r.dir.x = 0.0f;
-    const float tmax = i % 3 ? kInf : 2.0f;
+    const RandomPack c = random_pack(rng, i, true);
+    const TriangleVertices8 packed = TriangleVertices8::pack(c.tris);
+    const Ray& r = c.ray;
+    const float tmax = c.tmax;
     const WatertightTriangle::RayData data = WatertightTriangle::precompute(r);
     TriangleHit a{}, b{};
     const int lane_simd = intersect8_watertight_avx2(data, tmax, packed, a);
