@@ -7,7 +7,6 @@
 //     bvh8:watertight:robust leaks no ray through the tree either;
 //   a builder from raybench/bvh/bvh2_builders.h ("bvh8:sweep", "bvh8:lbvh").
 #include <optional>
-#include <type_traits>
 
 #include <fmt/format.h>
 
@@ -29,9 +28,7 @@ class Bvh8Backend final : public Backend {
   void build(const Scene& scene) override {
     Bvh2BuildOptions options;
     options.leaf_granularity = 8;  // leaves are tested 8 triangles at once
-    constexpr Bvh8Leaves leaves =
-        std::is_same_v<Leaf, Bvh8Watertight> ? Bvh8Leaves::kVertices : Bvh8Leaves::kMollerTrumbore;
-    bvh_ = collapse_to_bvh8(build_bvh2(scene.triangles, builder_, options), scene.triangles, leaves);
+    bvh_ = collapse_to_bvh8(build_bvh2(scene.triangles, builder_, options), scene.triangles, Leaf::kLeaves);
   }
 
   std::size_t memory_bytes() const override { return bvh_.memory_bytes(); }

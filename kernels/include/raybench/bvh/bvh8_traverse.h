@@ -29,6 +29,7 @@ inline constexpr std::size_t kMaxDepth = 128;  // BVH2 depth is bounded by 96 (b
 }  // namespace bvh8_detail
 
 struct Bvh8MollerTrumbore {
+  static constexpr Bvh8Leaves kLeaves = Bvh8Leaves::kMollerTrumbore;  // what collapse_to_bvh8 must store
   using RayData = Ray;
   static RayData precompute(const Ray& ray) { return ray; }
   static int intersect(const RayData& ray, float tmax, const Bvh8& bvh, std::uint32_t pack, TriangleHit& out) {
@@ -37,6 +38,7 @@ struct Bvh8MollerTrumbore {
 };
 
 struct Bvh8Watertight {
+  static constexpr Bvh8Leaves kLeaves = Bvh8Leaves::kVertices;
   using RayData = WatertightTriangle::RayData;
   static RayData precompute(const Ray& ray) { return WatertightTriangle::precompute(ray); }
   static int intersect(const RayData& ray, float tmax, const Bvh8& bvh, std::uint32_t pack, TriangleHit& out) {
