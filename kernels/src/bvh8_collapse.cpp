@@ -1,10 +1,39 @@
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "raybench/bvh/bvh8.h"
 
 namespace raybench {
 namespace {
+
+// Bvh8Node::far_to_near: for each octant, the lanes sorted by how far their
+// box centre lies along the octant's diagonal (+x+y+z for octant 0, -x for
+// bit 0 ...), farthest first; empty lanes go first, as no ray enters them
+// (so do NaN boxes of a broken mesh, which no ray enters either).
+// Ties keep lane order, so the result depends only on the boxes.
+void order_children(Bvh8Node& node) {
+  for (int octant = 0; octant < 8; ++octant) {
+    float along[8];
+    int lanes[8];
+    for (int lane = 0; lane < 8; ++lane) {
+      lanes[lane] = lane;
+      along[lane] = std::numeric_limits<float>::infinity();
+      if (node.child[lane] == Bvh8::kEmptyChild) continue;
+      along[lane] = 0.0f;
+      for (int a = 0; a < 3; ++a) {
+        const float centre2 = node.bounds.lower[a][lane] + node.bounds.upper[a][lane];
+        along[lane] += (octant >> a & 1) ? -centre2 : centre2;
+      }
+      // A NaN box must not break the sort's strict weak order.
+      if (std::isnan(along[lane])) along[lane] = std::numeric_limits<float>::infinity();
+    }
+    std::stable_sort(lanes, lanes + 8, [&](int a, int b) { return along[a] > along[b]; });
+    node.far_to_near[octant] = 0;
+    for (int rank = 0; rank < 8; ++rank) node.far_to_near[octant] |= static_cast<std::uint32_t>(lanes[rank]) << (3 * rank);
+  }
+}
 
 class Collapser {
  public:
@@ -56,6 +85,7 @@ class Collapser {
     Bvh8Node& node = out_.nodes[index];
     node.bounds = BBox8::pack({boxes, kids.size()});
     std::copy(children, children + 8, node.child);
+    order_children(node);
     return index;
   }
 
@@ -81,6 +111,7 @@ Bvh8 collapse_to_bvh8(const Bvh2& bvh2, std::span<const Triangle> triangles, Bvh
     out.nodes[0].bounds = BBox8::pack({&box, 1});
     std::fill(out.nodes[0].child, out.nodes[0].child + 8, Bvh8::kEmptyChild);
     out.nodes[0].child[0] = pack;
+    order_children(out.nodes[0]);
   } else {
     c.collapse(0, 0);
   }

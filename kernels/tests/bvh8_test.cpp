@@ -2,6 +2,7 @@
 // the BVH2 of every builder: the collapse keeps every triangle exactly once
 // under bounds that contain it, and traversal answers exactly as testing
 // every triangle does.
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -220,6 +221,81 @@ TEST_P(Bvh8Build, SahCostCountsNodeVisitsAndPackTests) {
   EXPECT_GT(cost, 1.0);
   EXPECT_EQ(build({}).sah_cost(), 0.0);
 }
+
+TEST_P(Bvh8Build, EveryNodeOrdersItsChildrenFarToNearAlongEachOctantsDiagonal) {
+  const auto tris = random_soup(5000, 4);
+  const Bvh8 bvh = build(tris);
+  for (const Bvh8Node& node : bvh.nodes) {
+    for (int octant = 0; octant < 8; ++octant) {
+      // Along the octant's diagonal: +x for bit 0 clear, -x when set, and so on.
+      const auto along = [&](int lane) {
+        float d = 0.0f;
+        for (int a = 0; a < 3; ++a) {
+          const float centre2 = node.bounds.lower[a][lane] + node.bounds.upper[a][lane];
+          d += (octant >> a & 1) ? -centre2 : centre2;
+        }
+        return d;
+      };
+      unsigned seen = 0;
+      bool children_started = false;
+      float previous = kInf;
+      for (int rank = 0; rank < 8; ++rank) {
+        const int lane = far_to_near_lane(node, octant, rank);
+        seen |= 1u << lane;
+        if (node.child[lane] == Bvh8::kEmptyChild) {
+          EXPECT_FALSE(children_started) << "empty lanes come first";
+          continue;
+        }
+        children_started = true;
+        EXPECT_LE(along(lane), previous) << "octant " << octant << " rank " << rank;
+        previous = along(lane);
+      }
+      EXPECT_EQ(seen, 0xffu) << "a permutation of the 8 lanes";
+    }
+  }
+}
+
+TEST(Bvh8Traversal, ARaysOctantIsWhereItsSlabTestEntersByTheUpperPlane) {
+  EXPECT_EQ(ray_octant(Slab::precompute(Ray{{0, 0, 0}, 0.0f, {1, 2, 3}, kInf})), 0);
+  EXPECT_EQ(ray_octant(Slab::precompute(Ray{{0, 0, 0}, 0.0f, {-1, 2, -3}, kInf})), 0b101);
+  EXPECT_EQ(ray_octant(Slab::precompute(Ray{{0, 0, 0}, 0.0f, {-0.0f, 0.0f, -1}, kInf})), 0b101);  // -0 as negative
+}
+
+#if defined(__AVX2__)
+// The AVX2 traversal permutes and compacts what the scalar fallback pushes
+// lane by lane: both must leave the same entries in the same order.
+TEST(Bvh8Traversal, TheCompactedPushStoresWhatTheLaneByLanePushStores) {
+  std::mt19937 rng(5);
+  Bvh8Node node{};
+  for (int lane = 0; lane < 8; ++lane) node.child[lane] = 100 + static_cast<std::uint32_t>(lane);
+  for (int trial = 0; trial < 2000; ++trial) {
+    int lanes[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+    std::shuffle(lanes, lanes + 8, rng);
+    const int octant = static_cast<int>(rng() % 8);
+    node.far_to_near[octant] = 0;
+    for (int rank = 0; rank < 8; ++rank) node.far_to_near[octant] |= static_cast<std::uint32_t>(lanes[rank]) << (3 * rank);
+    alignas(32) float entry[8];
+    for (float& e : entry) e = static_cast<float>(rng() % 1000);
+    const unsigned mask = rng() % 256;
+
+    bvh8_detail::Stack scalar, simd;
+    scalar.top = simd.top = 3;  // pushes land above what is there
+    bvh8_detail::push_far_to_near_scalar(scalar, node, octant, mask, entry);
+    const __m256i order = bvh8_detail::unpack_lanes<3>(node.far_to_near[octant]);
+    const __m256i refs =
+        _mm256_permutevar8x32_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(node.child)), order);
+    // The mask in rank order, as the traversal computes it from the permuted hit lanes.
+    unsigned ranked = 0;
+    for (int rank = 0; rank < 8; ++rank) ranked |= (mask >> far_to_near_lane(node, octant, rank) & 1u) << rank;
+    bvh8_detail::push_compacted(simd, refs, _mm256_permutevar8x32_ps(_mm256_load_ps(entry), order), ranked);
+    ASSERT_EQ(simd.top, scalar.top);
+    for (int i = 3; i < scalar.top; ++i) {
+      EXPECT_EQ(simd.ref[i], scalar.ref[i]);
+      EXPECT_EQ(simd.entry[i], scalar.entry[i]);
+    }
+  }
+}
+#endif
 
 INSTANTIATE_TEST_SUITE_P(Builders, Bvh8Build, ::testing::ValuesIn(kBvh2Builders),
                          [](const auto& info) { return std::string(to_string(info.param)); });

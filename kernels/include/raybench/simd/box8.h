@@ -55,8 +55,15 @@ inline unsigned intersect8_scalar(const Slab::Precomputed& r, float tmax, const 
 }
 
 #if defined(__AVX2__)
+// The AVX2 test with its answers left in registers for the traversal to
+// permute: `hit` all ones in the lanes entered, `t_entry` their entry
+// distances (meaningless in the other lanes).
+struct Box8Hits {
+  __m256 hit, t_entry;
+};
+
 template <typename BoxTest = Slab>
-inline unsigned intersect8_avx2(const Slab::Precomputed& r, float tmax, const BBox8& b, float entry[8]) {
+inline Box8Hits slab8_avx2(const Slab::Precomputed& r, float tmax, const BBox8& b) {
   __m256 t_entry = _mm256_set1_ps(r.tnear), t_exit = _mm256_set1_ps(tmax);
   for (int a = 0; a < 3; ++a) {
     const float* near_plane = r.negative[a] ? b.upper[a] : b.lower[a];
@@ -78,8 +85,14 @@ inline unsigned intersect8_avx2(const Slab::Precomputed& r, float tmax, const BB
   // Slab::overlaps: entry <= exit, and an entry at +inf is never reached.
   const __m256 hit = _mm256_and_ps(_mm256_cmp_ps(t_entry, t_exit, _CMP_LE_OQ),
                                    _mm256_cmp_ps(t_entry, _mm256_set1_ps(std::numeric_limits<float>::infinity()), _CMP_LT_OQ));
-  _mm256_store_ps(entry, _mm256_blendv_ps(_mm256_set1_ps(std::numeric_limits<float>::infinity()), t_entry, hit));
-  return static_cast<unsigned>(_mm256_movemask_ps(hit));
+  return {hit, t_entry};
+}
+
+template <typename BoxTest = Slab>
+inline unsigned intersect8_avx2(const Slab::Precomputed& r, float tmax, const BBox8& b, float entry[8]) {
+  const Box8Hits h = slab8_avx2<BoxTest>(r, tmax, b);
+  _mm256_store_ps(entry, _mm256_blendv_ps(_mm256_set1_ps(std::numeric_limits<float>::infinity()), h.t_entry, h.hit));
+  return static_cast<unsigned>(_mm256_movemask_ps(h.hit));
 }
 #endif
 
