@@ -23,6 +23,7 @@ const std::vector<Family>& families() {
       {"embree", make_embree_backend, embree_backend_names},
       {"bvh2", make_bvh2_backend, bvh2_backend_names},
       {"bvh8", make_bvh8_backend, bvh8_backend_names},
+      {"bvh4", make_bvh4_backend, bvh4_backend_names},
       {"reference", make_reference_backend, reference_backend_names},
   };
   return list;

@@ -18,8 +18,8 @@
 #include "gbench.h"
 #include "metadata.h"
 #include "random.h"
-#include "raybench/simd/box8.h"
-#include "raybench/simd/triangle8.h"
+#include "raybench/simd/wide_box.h"
+#include "raybench/simd/wide_triangle.h"
 #include "raybench/variants.h"
 
 namespace raybench {
@@ -277,11 +277,11 @@ void add_batched(std::vector<Case>& cases, std::size_t pairs) {
       };
       cases.push_back(std::move(c));
     };
-    triangle_case("scalar_x8", intersect8_scalar);
-    box_case("scalar_x8", intersect8_scalar);
+    triangle_case("scalar_x8", intersect_pack_scalar<8>);
+    box_case("scalar_x8", intersect_boxes_scalar<Slab, 8>);
 #if defined(__AVX2__)
-    triangle_case("avx2_x8", intersect8_avx2);
-    box_case("avx2_x8", intersect8_avx2);
+    triangle_case("avx2_x8", intersect_pack_simd<8>);
+    box_case("avx2_x8", intersect_boxes_simd<Slab, 8>);
 #endif
   }
 }

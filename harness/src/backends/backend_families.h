@@ -23,6 +23,9 @@ std::vector<BackendInfo> bvh2_backend_names();
 std::unique_ptr<Backend> make_bvh8_backend(const std::string& name, const std::vector<std::string>& options,
                                            const BackendConfig& config);
 std::vector<BackendInfo> bvh8_backend_names();
+std::unique_ptr<Backend> make_bvh4_backend(const std::string& name, const std::vector<std::string>& options,
+                                           const BackendConfig& config);
+std::vector<BackendInfo> bvh4_backend_names();
 
 std::unique_ptr<Backend> make_reference_backend(const std::string& name, const std::vector<std::string>& options,
                                                 const BackendConfig& config);

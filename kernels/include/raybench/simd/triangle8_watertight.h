@@ -13,7 +13,7 @@
 #include <span>
 
 #include "raybench/prim/triangle_watertight.h"
-#include "raybench/simd/triangle8.h"  // kHaveAvx2 and <immintrin.h>
+#include "raybench/simd/wide_triangle.h"  // kHaveAvx2 and <immintrin.h>
 
 namespace raybench {
 
@@ -42,7 +42,7 @@ struct alignas(32) TriangleVertices8 {
 
 // Lane by lane with the scalar test, every lane against the same tmax.
 // Returns the lane of the closest hit in (tnear, tmax], or -1; on equal t the
-// last such lane wins (as intersect8). Lowering tmax between lanes, as a
+// last such lane wins (as intersect_pack). Lowering tmax between lanes, as a
 // sequential loop would, is not the same: the test compares t_scaled with
 // tmax * det, whose rounding can reject a lane at exactly the same t.
 inline int intersect8_watertight_scalar(const WatertightTriangle::RayData& ray, float tmax, const TriangleVertices8& t,

@@ -1,7 +1,8 @@
-// Specification of the 8-wide BVH (bvh/bvh8.h, bvh/bvh8_traverse.h), over
-// the BVH2 of every builder: the collapse keeps every triangle exactly once
-// under bounds that contain it, and traversal answers exactly as testing
-// every triangle does.
+// Specification of the wide BVHs, 8 and 4 wide (bvh/wide_bvh.h,
+// bvh/wide_bvh_traverse.h), over the BVH2 of every builder: the collapse
+// keeps every triangle exactly once under bounds that contain it, each node
+// orders its children far to near per octant, and traversal answers exactly
+// as testing every triangle does.
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -13,7 +14,7 @@
 #include "bvh_test_util.h"
 
 #include "raybench/bvh/bvh2_builders.h"
-#include "raybench/bvh/bvh8_traverse.h"
+#include "raybench/bvh/wide_bvh_traverse.h"
 #include "raybench/geometry/uv_sphere.h"
 
 namespace raybench {
@@ -24,40 +25,47 @@ using testing::random_soup;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-class Bvh8Build : public ::testing::TestWithParam<Bvh2Builder> {
+class WideBvhBuild : public ::testing::TestWithParam<Bvh2Builder> {
  protected:
-  // As the bvh8 backend builds it: the SAH counts leaf tests in packs of 8.
-  Bvh8 build(const std::vector<Triangle>& tris) const {
+  // As the bvh8 and bvh4 backends build them: leaves of at most W triangles,
+  // and the SAH counts leaf tests in packs of W.
+  template <int W = 8>
+  WideBvh<W> build(const std::vector<Triangle>& tris) const {
     Bvh2BuildOptions options;
-    options.leaf_granularity = 8;
-    return collapse_to_bvh8(build_bvh2(tris, GetParam(), options), tris);
+    options.leaf_granularity = W;
+    options.max_leaf_size = W;
+    return collapse_bvh2<W>(build_bvh2(tris, GetParam(), options), tris);
+  }
+  // Runs body(std::integral_constant<int, W>) for both widths.
+  template <typename Body>
+  static void for_each_width(Body&& body) {
+    {
+      SCOPED_TRACE("8 wide");
+      body(std::integral_constant<int, 8>{});
+    }
+    {
+      SCOPED_TRACE("4 wide");
+      body(std::integral_constant<int, 4>{});
+    }
   }
 };
 
-BBox lane_box(const BBox8& b, int lane) {
-  BBox box;
-  for (int a = 0; a < 3; ++a) {
-    box.lower[a] = b.lower[a][lane];
-    box.upper[a] = b.upper[a][lane];
-  }
-  return box;
-}
-
 // Walks the tree checking bounds; counts how often each triangle appears.
-void check(const Bvh8& bvh, const std::vector<Triangle>& tris, std::uint32_t node, const BBox& parent,
+template <int W>
+void check(const WideBvh<W>& bvh, const std::vector<Triangle>& tris, std::uint32_t node, const BBox& parent,
            std::vector<int>& seen) {
-  for (int lane = 0; lane < 8; ++lane) {
+  for (int lane = 0; lane < W; ++lane) {
     const std::uint32_t child = bvh.nodes[node].child[lane];
-    const BBox box = lane_box(bvh.nodes[node].bounds, lane);
-    if (child == Bvh8::kEmptyChild) {
+    const BBox box = bvh.nodes[node].bounds.lane(lane);
+    if (child == WideBvh<W>::kEmptyChild) {
       EXPECT_TRUE(box.empty());
       continue;
     }
     EXPECT_TRUE(parent.contains(box));
-    if (child & Bvh8::kLeafBit) {
-      const std::uint32_t pack = child & ~Bvh8::kLeafBit;
-      for (int i = 0; i < 8; ++i) {
-        const std::int32_t id = bvh.pack_prims[8 * pack + i];
+    if (child & WideBvh<W>::kLeafBit) {
+      const std::uint32_t pack = child & ~WideBvh<W>::kLeafBit;
+      for (int i = 0; i < W; ++i) {
+        const std::int32_t id = bvh.pack_prims[W * pack + i];
         if (id < 0) continue;
         ++seen[static_cast<std::size_t>(id)];
         BBox t;
@@ -72,10 +80,11 @@ void check(const Bvh8& bvh, const std::vector<Triangle>& tris, std::uint32_t nod
   }
 }
 
-TEST_P(Bvh8Build, EveryTriangleInExactlyOneLeafUnderBoundsThatContainIt) {
+TEST_P(WideBvhBuild, EveryTriangleInExactlyOneLeafUnderBoundsThatContainIt) {
+  for_each_width([&](auto width) {
   for (std::size_t n : {1u, 7u, 9u, 5000u}) {
     const auto tris = random_soup(n, 1);
-    const Bvh8 bvh = build(tris);
+    const auto bvh = build<width()>(tris);
     std::vector<int> seen(tris.size(), 0);
     BBox everything;
     everything.extend(Vec3f{-1e9f, -1e9f, -1e9f});
@@ -84,18 +93,20 @@ TEST_P(Bvh8Build, EveryTriangleInExactlyOneLeafUnderBoundsThatContainIt) {
     for (std::size_t i = 0; i < tris.size(); ++i) EXPECT_EQ(seen[i], 1) << "triangle " << i << " of " << tris.size();
     EXPECT_LT(bvh.depth, 40u);
   }
+  });
 }
 
 // Closest and any hit of every ray against brute force; returns the number
 // of rays that hit. Exact ties in t may name either triangle.
-int expect_same_hits_as_brute_force(const Bvh8& bvh, const std::vector<Triangle>& tris, const std::vector<Ray>& rays) {
+template <int W>
+int expect_same_hits_as_brute_force(const WideBvh<W>& bvh, const std::vector<Triangle>& tris, const std::vector<Ray>& rays) {
   int hits = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
     const Ray& r = rays[i];
     const Hit expected = brute_force_closest(tris, r);
-    const Hit got = intersect_bvh8(bvh, r);
+    const Hit got = intersect_wide(bvh, r);
     EXPECT_EQ(got.hit(), expected.hit()) << "ray " << i;
-    EXPECT_EQ(occluded_bvh8(bvh, r), expected.hit()) << "ray " << i;
+    EXPECT_EQ(occluded_wide(bvh, r), expected.hit()) << "ray " << i;
     if (!expected.hit() || !got.hit()) continue;
     ++hits;
     EXPECT_EQ(got.t, expected.t) << "ray " << i;
@@ -108,9 +119,10 @@ int expect_same_hits_as_brute_force(const Bvh8& bvh, const std::vector<Triangle>
   return hits;
 }
 
-TEST_P(Bvh8Build, ClosestAndAnyHitMatchBruteForce) {
+TEST_P(WideBvhBuild, ClosestAndAnyHitMatchBruteForce) {
   const auto tris = random_soup(4000, 2);
-  const Bvh8 bvh = build(tris);
+  for_each_width([&](auto width) {
+  const auto bvh = build<width()>(tris);
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f), len(0.0f, 25.0f);
   std::vector<Ray> rays;
@@ -120,20 +132,23 @@ TEST_P(Bvh8Build, ClosestAndAnyHitMatchBruteForce) {
     rays.push_back(r);
   }
   EXPECT_GT(expect_same_hits_as_brute_force(bvh, tris, rays), 500);  // many hits, not only misses
+  });
 }
 
-TEST_P(Bvh8Build, EveryRayKindOnAMeshMatchesBruteForce) {
+TEST_P(WideBvhBuild, EveryRayKindOnAMeshMatchesBruteForce) {
   const auto tris = testing::sphere_cluster();
-  const Bvh8 bvh = build(tris);
-  unsigned seed = 20;
-  for (std::string_view kind : testing::kRayKinds) {
-    SCOPED_TRACE(std::string(kind));
-    const int hits = expect_same_hits_as_brute_force(bvh, tris, testing::rays_at(tris, kind, 2000, seed++));
-    EXPECT_GT(hits, 100);
-  }
+  for_each_width([&](auto width) {
+    const auto bvh = build<width()>(tris);
+    unsigned seed = 20;
+    for (std::string_view kind : testing::kRayKinds) {
+      SCOPED_TRACE(std::string(kind));
+      const int hits = expect_same_hits_as_brute_force(bvh, tris, testing::rays_at(tris, kind, 2000, seed++));
+      EXPECT_GT(hits, 100);
+    }
+  });
 }
 
-// Watertight leaves (Bvh8Leaves::kVertices), with plain and conservative
+// Watertight leaves (WideLeaves::kVertices), with plain and conservative
 // traversal, against the scalar watertight test on every triangle. The
 // closest t may differ by rounding where two triangles are within an ulp
 // (the test compares t_scaled with tmax * det), so t is compared to 1e-6.
@@ -143,9 +158,9 @@ void expect_watertight_leaves_match_brute_force(const Bvh8& bvh, const std::vect
   int hits = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
     const Hit expected = brute_force_closest<WatertightTriangle>(tris, rays[i]);
-    const Hit got = intersect_bvh8<Bvh8Watertight, BoxTest>(bvh, rays[i]);
+    const Hit got = intersect_wide<Bvh8Watertight, BoxTest>(bvh, rays[i]);
     ASSERT_EQ(got.hit(), expected.hit()) << "ray " << i;
-    EXPECT_EQ((occluded_bvh8<Bvh8Watertight, BoxTest>(bvh, rays[i])), expected.hit()) << "ray " << i;
+    EXPECT_EQ((occluded_wide<Bvh8Watertight, BoxTest>(bvh, rays[i])), expected.hit()) << "ray " << i;
     if (!got.hit()) continue;
     ++hits;
     EXPECT_NEAR(got.t, expected.t, 1e-6f * expected.t) << "ray " << i;
@@ -153,11 +168,11 @@ void expect_watertight_leaves_match_brute_force(const Bvh8& bvh, const std::vect
   EXPECT_GT(hits, 100);
 }
 
-TEST_P(Bvh8Build, WatertightLeavesMatchTheScalarWatertightTestOnEveryRayKind) {
+TEST_P(WideBvhBuild, WatertightLeavesMatchTheScalarWatertightTestOnEveryRayKind) {
   const auto tris = testing::sphere_cluster();
   Bvh2BuildOptions options;
   options.leaf_granularity = 8;
-  const Bvh8 bvh = collapse_to_bvh8(build_bvh2(tris, GetParam(), options), tris, Bvh8Leaves::kVertices);
+  const Bvh8 bvh = collapse_bvh2<8>(build_bvh2(tris, GetParam(), options), tris, WideLeaves::kVertices);
   EXPECT_TRUE(bvh.packs.empty());
   EXPECT_FALSE(bvh.vertex_packs.empty());
   unsigned seed = 40;
@@ -169,12 +184,12 @@ TEST_P(Bvh8Build, WatertightLeavesMatchTheScalarWatertightTestOnEveryRayKind) {
   }
 }
 
-TEST_P(Bvh8Build, WatertightRobustTraversalLeaksNoRayAimedAtEdgesAndVerticesFromInside) {
+TEST_P(WideBvhBuild, WatertightRobustTraversalLeaksNoRayAimedAtEdgesAndVerticesFromInside) {
   std::vector<Triangle> tris;
   append_uv_sphere(tris, {0, 0, 0}, 1.0f, 24, 48);
   Bvh2BuildOptions options;
   options.leaf_granularity = 8;
-  const Bvh8 bvh = collapse_to_bvh8(build_bvh2(tris, GetParam(), options), tris, Bvh8Leaves::kVertices);
+  const Bvh8 bvh = collapse_bvh2<8>(build_bvh2(tris, GetParam(), options), tris, WideLeaves::kVertices);
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(-0.5f, 0.5f), s(0, 1);
   int leaks = 0;
@@ -182,50 +197,58 @@ TEST_P(Bvh8Build, WatertightRobustTraversalLeaksNoRayAimedAtEdgesAndVerticesFrom
     const Triangle& t = tris[static_cast<std::size_t>(i) * 7919 % tris.size()];
     const Vec3f target = i % 2 ? t.v1 : t.v0 + (t.v2 - t.v0) * s(rng);  // a vertex, or a float point of an edge
     const Vec3f org{u(rng), u(rng), u(rng)};
-    leaks += !intersect_bvh8<Bvh8Watertight, SlabRobust>(bvh, Ray{org, 0.0f, target - org, kInf}).hit();
+    leaks += !intersect_wide<Bvh8Watertight, SlabRobust>(bvh, Ray{org, 0.0f, target - org, kInf}).hit();
   }
   EXPECT_EQ(leaks, 0);
 }
 
-TEST_P(Bvh8Build, FindsTheClosedSphereFromInsideAndNothingOutsideIt) {
+TEST_P(WideBvhBuild, FindsTheClosedSphereFromInsideAndNothingOutsideIt) {
   std::vector<Triangle> tris;
   append_uv_sphere(tris, {0, 0, 0}, 1.0f, 24, 48);
-  const Bvh8 bvh = build(tris);
+  for_each_width([&](auto width) {
+  const auto bvh = build<width()>(tris);
   std::mt19937 rng(4);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   for (int i = 0; i < 2000; ++i) {
     const Ray r{{u(rng) * 0.5f, u(rng) * 0.5f, u(rng) * 0.5f}, 0.0f, normalize(Vec3f{u(rng), u(rng), u(rng)}), kInf};
-    const Hit h = intersect_bvh8(bvh, r);
+    const Hit h = intersect_wide(bvh, r);
     ASSERT_TRUE(h.hit()) << "ray " << i;
     EXPECT_NEAR(length(r.org + r.dir * h.t), 1.0f, 0.02f);
   }
   const Ray away{{3, 0, 0}, 0.0f, {1, 0, 0}, kInf};
-  EXPECT_FALSE(intersect_bvh8(bvh, away).hit());
+  EXPECT_FALSE(intersect_wide(bvh, away).hit());
+  });
 }
 
-TEST_P(Bvh8Build, EmptyInputBuildsATreeThatNothingHits) {
+TEST_P(WideBvhBuild, EmptyInputBuildsATreeThatNothingHits) {
   const std::vector<Triangle> none;
-  const Bvh8 bvh = build(none);
-  EXPECT_FALSE(intersect_bvh8(bvh, Ray{{0, 0, 0}, 0.0f, {0, 0, 1}, kInf}).hit());
-  EXPECT_FALSE(occluded_bvh8(bvh, Ray{{0, 0, 0}, 0.0f, {0, 0, 1}, kInf}));
+  for_each_width([&](auto width) {
+    const auto bvh = build<width()>(none);
+    EXPECT_FALSE(intersect_wide(bvh, Ray{{0, 0, 0}, 0.0f, {0, 0, 1}, kInf}).hit());
+    EXPECT_FALSE(occluded_wide(bvh, Ray{{0, 0, 0}, 0.0f, {0, 0, 1}, kInf}));
+  });
 }
 
-TEST_P(Bvh8Build, SahCostCountsNodeVisitsAndPackTests) {
+TEST_P(WideBvhBuild, SahCostCountsNodeVisitsAndPackTests) {
   // One triangle: the root visit, then its one pack, under a box of the root's area.
   const std::vector<Triangle> one{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}};
-  EXPECT_DOUBLE_EQ(build(one).sah_cost(), 2.0);
-  // Many: finite, and more than the root visit alone.
   const auto tris = random_soup(5000, 3);
-  const double cost = build(tris).sah_cost();
-  EXPECT_TRUE(std::isfinite(cost));
-  EXPECT_GT(cost, 1.0);
-  EXPECT_EQ(build({}).sah_cost(), 0.0);
+  for_each_width([&](auto width) {
+    EXPECT_DOUBLE_EQ(build<width()>(one).sah_cost(), 2.0);
+    // Many: finite, and more than the root visit alone.
+    const double cost = build<width()>(tris).sah_cost();
+    EXPECT_TRUE(std::isfinite(cost));
+    EXPECT_GT(cost, 1.0);
+    EXPECT_EQ(build<width()>({}).sah_cost(), 0.0);
+  });
 }
 
-TEST_P(Bvh8Build, EveryNodeOrdersItsChildrenFarToNearAlongEachOctantsDiagonal) {
+TEST_P(WideBvhBuild, EveryNodeOrdersItsChildrenFarToNearAlongEachOctantsDiagonal) {
   const auto tris = random_soup(5000, 4);
-  const Bvh8 bvh = build(tris);
-  for (const Bvh8Node& node : bvh.nodes) {
+  for_each_width([&](auto width) {
+  constexpr int W = width();
+  const auto bvh = build<W>(tris);
+  for (const WideNode<W>& node : bvh.nodes) {
     for (int octant = 0; octant < 8; ++octant) {
       // Along the octant's diagonal: +x for bit 0 clear, -x when set, and so on.
       const auto along = [&](int lane) {
@@ -239,10 +262,10 @@ TEST_P(Bvh8Build, EveryNodeOrdersItsChildrenFarToNearAlongEachOctantsDiagonal) {
       unsigned seen = 0;
       bool children_started = false;
       float previous = kInf;
-      for (int rank = 0; rank < 8; ++rank) {
+      for (int rank = 0; rank < W; ++rank) {
         const int lane = far_to_near_lane(node, octant, rank);
         seen |= 1u << lane;
-        if (node.child[lane] == Bvh8::kEmptyChild) {
+        if (node.child[lane] == WideBvh<W>::kEmptyChild) {
           EXPECT_FALSE(children_started) << "empty lanes come first";
           continue;
         }
@@ -250,44 +273,48 @@ TEST_P(Bvh8Build, EveryNodeOrdersItsChildrenFarToNearAlongEachOctantsDiagonal) {
         EXPECT_LE(along(lane), previous) << "octant " << octant << " rank " << rank;
         previous = along(lane);
       }
-      EXPECT_EQ(seen, 0xffu) << "a permutation of the 8 lanes";
+      EXPECT_EQ(seen, (1u << W) - 1) << "a permutation of the W lanes";
     }
   }
+  });
 }
 
-TEST(Bvh8Traversal, ARaysOctantIsWhereItsSlabTestEntersByTheUpperPlane) {
+TEST(WideBvhTraversal, ARaysOctantIsWhereItsSlabTestEntersByTheUpperPlane) {
   EXPECT_EQ(ray_octant(Slab::precompute(Ray{{0, 0, 0}, 0.0f, {1, 2, 3}, kInf})), 0);
   EXPECT_EQ(ray_octant(Slab::precompute(Ray{{0, 0, 0}, 0.0f, {-1, 2, -3}, kInf})), 0b101);
   EXPECT_EQ(ray_octant(Slab::precompute(Ray{{0, 0, 0}, 0.0f, {-0.0f, 0.0f, -1}, kInf})), 0b101);  // -0 as negative
 }
 
 #if defined(__AVX2__)
-// The AVX2 traversal permutes and compacts what the scalar fallback pushes
+// The SIMD traversal permutes and compacts what the scalar fallback pushes
 // lane by lane: both must leave the same entries in the same order.
-TEST(Bvh8Traversal, TheCompactedPushStoresWhatTheLaneByLanePushStores) {
+template <int W>
+void expect_compacted_push_equals_lane_by_lane_push() {
   std::mt19937 rng(5);
-  Bvh8Node node{};
-  for (int lane = 0; lane < 8; ++lane) node.child[lane] = 100 + static_cast<std::uint32_t>(lane);
+  WideNode<W> node{};
+  for (int lane = 0; lane < W; ++lane) node.child[lane] = 100 + static_cast<std::uint32_t>(lane);
+  constexpr int bits = WideNode<W>::kOrderBits;
   for (int trial = 0; trial < 2000; ++trial) {
-    int lanes[8] = {0, 1, 2, 3, 4, 5, 6, 7};
-    std::shuffle(lanes, lanes + 8, rng);
+    int lanes[W];
+    for (int lane = 0; lane < W; ++lane) lanes[lane] = lane;
+    std::shuffle(lanes, lanes + W, rng);
     const int octant = static_cast<int>(rng() % 8);
-    node.far_to_near[octant] = 0;
-    for (int rank = 0; rank < 8; ++rank) node.far_to_near[octant] |= static_cast<std::uint32_t>(lanes[rank]) << (3 * rank);
-    alignas(32) float entry[8];
+    std::uint32_t order = 0;
+    for (int rank = 0; rank < W; ++rank) order |= static_cast<std::uint32_t>(lanes[rank]) << (bits * rank);
+    node.far_to_near[octant] = static_cast<typename WideNode<W>::Order>(order);
+    alignas(32) float entry[W];
     for (float& e : entry) e = static_cast<float>(rng() % 1000);
-    const unsigned mask = rng() % 256;
+    const unsigned mask = rng() % (1u << W);
 
-    bvh8_detail::Stack scalar, simd;
+    wide_bvh_detail::Stack<W> scalar, simd;
     scalar.top = simd.top = 3;  // pushes land above what is there
-    bvh8_detail::push_far_to_near_scalar(scalar, node, octant, mask, entry);
-    const __m256i order = bvh8_detail::unpack_lanes<3>(node.far_to_near[octant]);
-    const __m256i refs =
-        _mm256_permutevar8x32_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(node.child)), order);
+    wide_bvh_detail::push_far_to_near_scalar(scalar, node, octant, mask, entry);
+    const auto permutation = wide_bvh_detail::unpack_lanes<W, bits>(node.far_to_near[octant]);
     // The mask in rank order, as the traversal computes it from the permuted hit lanes.
     unsigned ranked = 0;
-    for (int rank = 0; rank < 8; ++rank) ranked |= (mask >> far_to_near_lane(node, octant, rank) & 1u) << rank;
-    bvh8_detail::push_compacted(simd, refs, _mm256_permutevar8x32_ps(_mm256_load_ps(entry), order), ranked);
+    for (int rank = 0; rank < W; ++rank) ranked |= (mask >> far_to_near_lane(node, octant, rank) & 1u) << rank;
+    wide_bvh_detail::push_compacted(simd, simd::IntLanes<W>::load(node.child).permute(permutation),
+                                    simd::FloatLanes<W>::load(entry).permute(permutation), ranked);
     ASSERT_EQ(simd.top, scalar.top);
     for (int i = 3; i < scalar.top; ++i) {
       EXPECT_EQ(simd.ref[i], scalar.ref[i]);
@@ -295,9 +322,14 @@ TEST(Bvh8Traversal, TheCompactedPushStoresWhatTheLaneByLanePushStores) {
     }
   }
 }
+
+TEST(WideBvhTraversal, TheCompactedPushStoresWhatTheLaneByLanePushStores) {
+  expect_compacted_push_equals_lane_by_lane_push<8>();
+  expect_compacted_push_equals_lane_by_lane_push<4>();
+}
 #endif
 
-INSTANTIATE_TEST_SUITE_P(Builders, Bvh8Build, ::testing::ValuesIn(kBvh2Builders),
+INSTANTIATE_TEST_SUITE_P(Builders, WideBvhBuild, ::testing::ValuesIn(kBvh2Builders),
                          [](const auto& info) { return std::string(to_string(info.param)); });
 
 }  // namespace

@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "raybench/simd/box8.h"
-#include "raybench/simd/triangle8.h"
+#include "raybench/simd/wide_box.h"
+#include "raybench/simd/wide_triangle.h"
 #include "raybench/simd/triangle8_watertight.h"
 #include "raybench/geometry/uv_sphere.h"
 
@@ -17,25 +17,25 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-TEST(Triangle8, UnusedLanesNeverHit) {
+TEST(TrianglePack, UnusedLanesNeverHit) {
   const std::vector<Triangle> one{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}};
   const Triangle8 packed = Triangle8::pack(one);
   TriangleHit h;
-  EXPECT_EQ(intersect8(Ray{{0.25f, 0.25f, 1}, 0, {0, 0, -1}, kInf}, kInf, packed, h), 0);
+  EXPECT_EQ(intersect_pack(Ray{{0.25f, 0.25f, 1}, 0, {0, 0, -1}, kInf}, kInf, packed, h), 0);
   EXPECT_FLOAT_EQ(h.t, 1.0f);
-  EXPECT_EQ(intersect8(Ray{{5, 5, 1}, 0, {0, 0, -1}, kInf}, kInf, packed, h), -1);
+  EXPECT_EQ(intersect_pack(Ray{{5, 5, 1}, 0, {0, 0, -1}, kInf}, kInf, packed, h), -1);
 }
 
-TEST(Triangle8, ReturnsTheClosestLane) {
+TEST(TrianglePack, ReturnsTheClosestLane) {
   std::vector<Triangle> stack;
   for (float z : {-3.0f, -1.0f, -2.0f}) stack.push_back({{0, 0, z}, {1, 0, z}, {0, 1, z}});
   TriangleHit h;
-  EXPECT_EQ(intersect8(Ray{{0.25f, 0.25f, 0}, 0, {0, 0, -1}, kInf}, kInf, Triangle8::pack(stack), h), 1);
+  EXPECT_EQ(intersect_pack(Ray{{0.25f, 0.25f, 0}, 0, {0, 0, -1}, kInf}, kInf, Triangle8::pack(stack), h), 1);
   EXPECT_FLOAT_EQ(h.t, 1.0f);
 }
 
 #if defined(__AVX2__)
-// Case i of the AVX2-against-scalar tests: 1 to 8 random triangles (every
+// Case i of the SIMD-against-scalar tests: 1 to `width` random triangles (every
 // 10th case with two equal ones, every 7th with a degenerate one) and a ray
 // aimed at a point of one of them, so most rays exercise hits; every 13th
 // ray has a zero direction component, every third case a finite tmax. With
@@ -47,7 +47,7 @@ struct RandomPack {
   float tmax;
 };
 
-RandomPack random_pack(std::mt19937& rng, int i, bool edge_cases) {
+RandomPack random_pack(std::mt19937& rng, int i, bool edge_cases, int width = 8) {
   std::uniform_real_distribution<float> u(-1, 1);
   RandomPack c;
   for (int k = 0; k < 8; ++k) c.tris.push_back({{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}});
@@ -55,8 +55,8 @@ RandomPack random_pack(std::mt19937& rng, int i, bool edge_cases) {
   if (i % 10 == 0) tris[3] = tris[2];                                // duplicates tie
   if (i % 7 == 0) tris[5] = {tris[5].v0, tris[5].v0, tris[5].v1};     // degenerate
   if (edge_cases && i % 5 == 0) tris[1].v0 = tris[0].v1, tris[1].v1 = tris[0].v0;  // a shared edge
-  tris.resize(static_cast<std::size_t>(1 + i % 8));
-  const Triangle aim = tris[static_cast<std::size_t>(i % 8 % (1 + i % 8))];
+  tris.resize(static_cast<std::size_t>(1 + i % width));
+  const Triangle aim = tris[static_cast<std::size_t>(i % width % (1 + i % width))];
   const float wa = std::fabs(u(rng)), wb = edge_cases && i % 4 == 0 ? 0.0f : std::fabs(u(rng)) * (1.0f - wa);
   const Vec3f org{u(rng) * 3, u(rng) * 3, u(rng) * 3};
   const Vec3f target = edge_cases && i % 6 == 0 ? aim.v0 : aim.v0 + (aim.v1 - aim.v0) * wa + (aim.v2 - aim.v0) * wb;
@@ -66,17 +66,18 @@ RandomPack random_pack(std::mt19937& rng, int i, bool edge_cases) {
   return c;
 }
 
-TEST(Triangle8, Avx2AnswersExactlyAsTheScalarKernel) {
+template <int W>
+void expect_triangle_pack_simd_equals_scalar() {
   std::mt19937 rng(1);
   int hits = 0;
   for (int i = 0; i < 20000; ++i) {
-    const RandomPack c = random_pack(rng, i, false);
-    const Triangle8 packed = Triangle8::pack(c.tris);
+    const RandomPack c = random_pack(rng, i, false, W);
+    const TrianglePack<W> packed = TrianglePack<W>::pack(c.tris);
     const Ray& r = c.ray;
     const float tmax = c.tmax;
     TriangleHit a{}, b{};
-    const int lane_simd = intersect8_avx2(r, tmax, packed, a);
-    const int lane_scalar = intersect8_scalar(r, tmax, packed, b);
+    const int lane_simd = intersect_pack_simd(r, tmax, packed, a);
+    const int lane_scalar = intersect_pack_scalar(r, tmax, packed, b);
     ASSERT_EQ(lane_simd, lane_scalar) << "ray " << i;
     if (lane_simd < 0) continue;
     ++hits;
@@ -87,8 +88,11 @@ TEST(Triangle8, Avx2AnswersExactlyAsTheScalarKernel) {
   EXPECT_GT(hits, 5000);
 }
 
-template <typename BoxTest>
-void expect_box8_avx2_equals_scalar() {
+TEST(TrianglePack, Avx2AnswersExactlyAsTheScalarKernel) { expect_triangle_pack_simd_equals_scalar<8>(); }
+TEST(TrianglePack, SseFourWideAnswersExactlyAsTheScalarKernel) { expect_triangle_pack_simd_equals_scalar<4>(); }
+
+template <typename BoxTest, int W>
+void expect_boxes_simd_equals_scalar() {
   std::mt19937 rng(2);
   std::uniform_real_distribution<float> u(-1, 1);
   int hits = 0;
@@ -100,7 +104,7 @@ void expect_box8_avx2_equals_scalar() {
       b.extend(Vec3f{u(rng), u(rng), u(rng)});
       boxes.push_back(b);
     }
-    const BBox8 packed = BBox8::pack({boxes.data(), static_cast<std::size_t>(1 + i % 8)});
+    const BBoxWide<W> packed = BBoxWide<W>::pack({boxes.data(), static_cast<std::size_t>(1 + i % W)});
     const Vec3f org{u(rng) * 3, u(rng) * 3, u(rng) * 3}, target{u(rng), u(rng), u(rng)};
     Ray r{org, 0.0f, target - org, kInf};  // aimed into the region the boxes fill
     if (i % 11 == 0) {  // axis-parallel, origin on a slab plane: the NaN case
@@ -108,21 +112,23 @@ void expect_box8_avx2_equals_scalar() {
       r.org.x = boxes[0].lower.x;
     }
     const Slab::Precomputed pre = Slab::precompute(r);
-    alignas(32) float e_simd[8], e_scalar[8];
-    const unsigned m_simd = intersect8_avx2<BoxTest>(pre, kInf, packed, e_simd);
-    const unsigned m_scalar = intersect8_scalar<BoxTest>(pre, kInf, packed, e_scalar);
+    alignas(32) float e_simd[W], e_scalar[W];
+    const unsigned m_simd = intersect_boxes_simd<BoxTest>(pre, kInf, packed, e_simd);
+    const unsigned m_scalar = intersect_boxes_scalar<BoxTest>(pre, kInf, packed, e_scalar);
     ASSERT_EQ(m_simd, m_scalar) << "ray " << i;
-    for (int lane = 0; lane < 8; ++lane)
+    for (int lane = 0; lane < W; ++lane)
       if (m_simd >> lane & 1) {
         EXPECT_EQ(e_simd[lane], e_scalar[lane]);
       }
     hits += __builtin_popcount(m_simd);
   }
-  EXPECT_GT(hits, 10000);
+  EXPECT_GT(hits, W == 8 ? 10000 : 5000);
 }
 
-TEST(Box8, Avx2AnswersExactlyAsTheScalarSlabTest) { expect_box8_avx2_equals_scalar<Slab>(); }
-TEST(Box8, Avx2AnswersExactlyAsTheScalarRobustSlabTest) { expect_box8_avx2_equals_scalar<SlabRobust>(); }
+TEST(Box8, Avx2AnswersExactlyAsTheScalarSlabTest) { expect_boxes_simd_equals_scalar<Slab, 8>(); }
+TEST(Box8, Avx2AnswersExactlyAsTheScalarRobustSlabTest) { expect_boxes_simd_equals_scalar<SlabRobust, 8>(); }
+TEST(Box4, SseAnswersExactlyAsTheScalarSlabTest) { expect_boxes_simd_equals_scalar<Slab, 4>(); }
+TEST(Box4, SseAnswersExactlyAsTheScalarRobustSlabTest) { expect_boxes_simd_equals_scalar<SlabRobust, 4>(); }
 
 TEST(Watertight8, Avx2AnswersExactlyAsTheScalarWoopTestEvenThroughEdgesAndVertices) {
   std::mt19937 rng(3);
@@ -178,7 +184,7 @@ TEST(Box8, EmptyLanesAreMissed) {
   const std::vector<BBox> one{BBox{{0, 0, 0}, {1, 1, 1}}};
   alignas(32) float entry[8];
   const Slab::Precomputed r = Slab::precompute(Ray{{0.5f, 0.5f, -1}, 0, {0, 0, 1}, kInf});
-  EXPECT_EQ(intersect8(r, kInf, BBox8::pack(one), entry), 1u);
+  EXPECT_EQ(intersect_boxes(r, kInf, BBox8::pack(one), entry), 1u);
   EXPECT_FLOAT_EQ(entry[0], 1.0f);
 }
 

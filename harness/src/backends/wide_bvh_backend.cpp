@@ -1,0 +1,131 @@
+// Our wide BVHs: a BVH2 (binned SAH by default, TBB-parallel), collapsed to
+// 8-wide (bvh8: AVX2) or 4-wide (bvh4: SSE) nodes, traversed with one SIMD
+// slab test per node and leaves of up to W triangles tested at once.
+// Options, in any order, each at most once:
+//   a triangle test: mt (Möller–Trumbore, simd/wide_triangle.h, the default)
+//     or, 8 wide only, watertight (Woop et al. 2013, simd/triangle8_watertight.h);
+//   robust: the conservative wide box test (Ize's padding), so that
+//     bvh8:watertight:robust leaks no ray through the tree either;
+//   a builder from raybench/bvh/bvh2_builders.h ("bvh8:sweep", "bvh4:lbvh").
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "backends/backend_families.h"
+#include "error.h"
+#include "raybench/bvh/bvh2_builders.h"
+#include "raybench/bvh/wide_bvh_traverse.h"
+
+namespace raybench {
+namespace {
+
+template <int W, typename Leaf, typename BoxTest>
+class WideBvhBackend final : public Backend {
+ public:
+  WideBvhBackend(std::string name, Bvh2Builder builder) : name_(std::move(name)), builder_(builder) {}
+
+  const std::string& name() const override { return name_; }
+
+  void build(const Scene& scene) override {
+    Bvh2BuildOptions options;
+    options.leaf_granularity = W;  // leaves are tested W triangles at once
+    options.max_leaf_size = W;     // and hold at most one pack
+    bvh_ = collapse_bvh2<W>(build_bvh2(scene.triangles, builder_, options), scene.triangles, Leaf::kLeaves);
+  }
+
+  std::size_t memory_bytes() const override { return bvh_.memory_bytes(); }
+
+  // WideBvh::sah_cost, of the wide tree traced: node visits and W-triangle
+  // pack tests cost 1 each (computed here, outside the timed build).
+  double sah_cost() const override { return bvh_.sah_cost(); }
+
+  void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      hits[i] = is_traceable(rays[i]) ? intersect_wide<Leaf, BoxTest>(bvh_, with_nonnegative_tnear(rays[i])) : Hit{};
+  }
+
+  void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override {
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      occluded[i] = is_traceable(rays[i]) && occluded_wide<Leaf, BoxTest>(bvh_, with_nonnegative_tnear(rays[i]));
+  }
+
+ private:
+  std::string name_;
+  Bvh2Builder builder_;
+  WideBvh<W> bvh_;
+};
+
+template <int W, typename Leaf>
+std::unique_ptr<Backend> make_with_box_test(const std::string& name, Bvh2Builder builder, bool robust) {
+  if (robust) return std::make_unique<WideBvhBackend<W, Leaf, SlabRobust>>(name, builder);
+  return std::make_unique<WideBvhBackend<W, Leaf, Slab>>(name, builder);
+}
+
+template <int W>
+std::unique_ptr<Backend> make_wide_backend(const std::string& name, const std::vector<std::string>& options) {
+  const std::string family = fmt::format("bvh{}", W);
+  const std::string tests = W == 8 ? "mt, watertight" : "mt";
+  const std::string valid = fmt::format("triangle tests: {}; robust; builders: {}", tests, bvh2_builder_names());
+  std::optional<std::string> test;
+  std::optional<Bvh2Builder> builder;
+  bool robust = false;
+  for (const std::string& o : options) {
+    const std::optional<Bvh2Builder> as_builder = parse_bvh2_builder(o);
+    const bool is_test = o == "mt" || o == "watertight";
+    if (W != 8 && o == "watertight")
+      throw InputError("", fmt::format("backend '{}': watertight leaves are 8 wide only; use bvh8:watertight", name));
+    if (!is_test && !as_builder && o != "robust")
+      throw InputError("", fmt::format("backend '{}': unknown option '{}' ({})", name, o, valid));
+    if ((is_test && test) || (as_builder && builder) || (o == "robust" && robust))
+      throw InputError("", fmt::format("backend '{}': {} takes a triangle test, 'robust' and a builder, each at most "
+                                       "once, in any order, e.g. {}:{}robust:sweep ({})",
+                                       name, family, family, W == 8 ? "watertight:" : "", valid));
+    if (as_builder) builder = as_builder;
+    else if (is_test) test = o;
+    else robust = true;
+  }
+  const Bvh2Builder b = builder.value_or(Bvh2Builder::kBinnedSah);
+  if constexpr (W == 8) {
+    if (test.value_or("mt") == "watertight") return make_with_box_test<8, Bvh8Watertight>(name, b, robust);
+  }
+  return make_with_box_test<W, WideMollerTrumbore>(name, b, robust);
+}
+
+template <int W>
+std::vector<BackendInfo> wide_backend_names() {
+  const std::string family = fmt::format("bvh{}", W);
+  std::vector<BackendInfo> out{
+      {family, fmt::format("{}-wide BVH collapsed from bvh2, {} node and leaf tests, Moller-Trumbore leaves of {}", W,
+                           kHaveAvx2 ? (W == 8 ? "AVX2" : "SSE") : "scalar fallback", W)}};
+  for (Bvh2Builder b : kBvh2Builders) {
+    if (b == Bvh2Builder::kBinnedSah) continue;  // the default: plain "bvh8"
+    out.push_back({family + ":" + std::string(to_string(b)),
+                   fmt::format("{} from a BVH2 built by {}; any {} name takes :<builder>", family, description(b), family)});
+  }
+  if constexpr (W == 8) {
+    out.push_back(
+        {"bvh8:watertight", "bvh8 with 8-wide watertight leaves (Woop, Benthin & Wald 2013) [watertight]", "watertight"});
+    out.push_back({"bvh8:watertight:robust",
+                   "bvh8:<test>:robust traverses with the conservative 8-wide box test: no ray leaks through the tree",
+                   "watertight"});
+  } else {
+    out.push_back({family + ":robust", fmt::format("{} with the conservative {}-wide box test", family, W)});
+  }
+  return out;
+}
+
+}  // namespace
+
+std::unique_ptr<Backend> make_bvh8_backend(const std::string& name, const std::vector<std::string>& options,
+                                           const BackendConfig&) {
+  return make_wide_backend<8>(name, options);
+}
+std::vector<BackendInfo> bvh8_backend_names() { return wide_backend_names<8>(); }
+
+std::unique_ptr<Backend> make_bvh4_backend(const std::string& name, const std::vector<std::string>& options,
+                                           const BackendConfig&) {
+  return make_wide_backend<4>(name, options);
+}
+std::vector<BackendInfo> bvh4_backend_names() { return wide_backend_names<4>(); }
+
+}  // namespace raybench

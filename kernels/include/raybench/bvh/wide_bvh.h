@@ -1,0 +1,98 @@
+// Wide BVHs collapsed from a Bvh2: WideBvh<8> (Bvh8) and WideBvh<4> (Bvh4).
+// Each node holds its W children's bounds structure-of-arrays (BBoxWide), so
+// one SIMD slab test visits all of them; leaves are TrianglePack<W>s of up to
+// W triangles, tested at once.
+// The collapse is the usual greedy one (Wald et al., "Getting Rid of Packets",
+// RT 2008; Embree's BVH8 from BVH2): open the child with the largest surface
+// area until W children or only leaves remain.
+// Each node also stores, for each of the 8 direction octants, an order of its
+// children from far to near along that octant's diagonal (by box centre), so
+// traversal orders the children it enters with one permutation instead of
+// sorting their distances: the octant ordering of wide BVHs (Ylitie, Karras,
+// Laine, "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide
+// BVHs", HPG 2017; tinybvh's BVH8_CPU does the same on the CPU).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <type_traits>
+#include <vector>
+
+#include "raybench/bvh/bvh2.h"
+#include "raybench/simd/triangle8_watertight.h"
+#include "raybench/simd/wide_box.h"
+#include "raybench/simd/wide_triangle.h"
+
+namespace raybench {
+
+// 256 bytes for W = 8, 128 for W = 4: whole cache lines.
+template <int W>
+struct alignas(64) WideNode {
+  static_assert(W == 4 || W == 8);
+  // Bits per lane index in far_to_near.
+  static constexpr int kOrderBits = W == 8 ? 3 : 2;
+  using Order = std::conditional_t<W == 8, std::uint32_t, std::uint8_t>;
+
+  BBoxWide<W> bounds;       // empty boxes in unused lanes: no ray enters them
+  std::uint32_t child[W];   // kEmptyChild, an inner node index, or kLeafBit | pack index
+  // far_to_near[octant]: the W lanes, kOrderBits each, lowest bits first, from
+  // the child farthest along the octant's diagonal to the nearest. The octant
+  // of a direction is bit a set when its slab test enters axis a by the upper
+  // plane (ray_octant).
+  Order far_to_near[8];
+};
+static_assert(sizeof(WideNode<8>) == 256 && sizeof(WideNode<4>) == 128);
+
+// A ray's octant: bit a set when the slab test enters axis a by the upper
+// plane (a negative direction component, or -0: the sign of 1/d).
+inline int ray_octant(const Slab::Precomputed& r) {
+  return static_cast<int>(r.negative[0]) | static_cast<int>(r.negative[1]) << 1 | static_cast<int>(r.negative[2]) << 2;
+}
+
+// Lane `rank` (0 = farthest) of a node's far-to-near order for `octant`.
+template <int W>
+inline int far_to_near_lane(const WideNode<W>& node, int octant, int rank) {
+  constexpr int bits = WideNode<W>::kOrderBits;
+  return static_cast<int>(static_cast<std::uint32_t>(node.far_to_near[octant]) >> (bits * rank) & ((1u << bits) - 1));
+}
+
+// What a leaf pack stores: Möller–Trumbore's v0, e1, e2 (TrianglePack), or
+// the triangles' own vertices for the watertight test (TriangleVertices8,
+// 8-wide only: the edges must not be rounded, or shared edges would no
+// longer match).
+enum class WideLeaves { kMollerTrumbore, kVertices };
+
+template <int W>
+struct WideBvh {
+  static constexpr int kWidth = W;
+  static constexpr std::uint32_t kLeafBit = 0x80000000u;
+  static constexpr std::uint32_t kEmptyChild = 0xffffffffu;
+
+  std::vector<WideNode<W>> nodes;               // nodes[0] is the root
+  std::vector<TrianglePack<W>> packs;           // WideLeaves::kMollerTrumbore: up to W triangles each
+  std::vector<TriangleVertices8> vertex_packs;  // WideLeaves::kVertices (W = 8): the same packs as vertices
+  std::vector<std::int32_t> pack_prims;         // W per pack: input triangle index, -1 in unused lanes
+  std::size_t depth = 0;                        // levels below the root; bounds the traversal stack
+
+  std::size_t memory_bytes() const {
+    return nodes.size() * sizeof(WideNode<W>) + packs.size() * sizeof(TrianglePack<W>) +
+           vertex_packs.size() * sizeof(TriangleVertices8) + pack_prims.size() * sizeof(std::int32_t);
+  }
+  // Surface-area-heuristic cost of the wide tree, relative to the root's
+  // area: visiting a node (one W-box test) and testing a pack (one W-triangle
+  // test) cost 1 each, weighted by the area of the box that leads to them.
+  // Not comparable with Bvh2::sah_cost, whose units are single tests.
+  double sah_cost() const;
+};
+using Bvh8 = WideBvh<8>;
+using Bvh4 = WideBvh<4>;
+using Bvh8Node = WideNode<8>;
+
+// Collapses `bvh2` (whose leaves hold at most W triangles, as every builder
+// of bvh2_builders.h makes them with max_leaf_size W) over `triangles`.
+// WideLeaves::kVertices needs W = 8 (std::invalid_argument otherwise).
+template <int W>
+WideBvh<W> collapse_bvh2(const Bvh2& bvh2, std::span<const Triangle> triangles,
+                         WideLeaves leaves = WideLeaves::kMollerTrumbore);
+
+}  // namespace raybench

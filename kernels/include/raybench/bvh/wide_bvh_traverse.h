@@ -1,0 +1,187 @@
+// Single-ray traversal of a WideBvh<W> (W = 8: AVX2, W = 4: SSE, or their
+// scalar fallback): one W-wide slab test per node; the children entered are
+// pushed in the node's stored far-to-near order for the ray's octant
+// (WideNode::far_to_near), so the nearest is popped next, without sorting
+// distances: one permutation orders them and a table-driven compaction
+// pushes them with two stores, branch-free. Their entry distances go on the
+// stack too, so a subtree farther than the current hit is skipped when
+// popped. Leaves are tested W triangles at once. Any hit returns at the first
+// hit in the interval, and pushes leaves above inner nodes so that they are
+// tested first.
+// The leaf test and the box test are policies: WideMollerTrumbore, or
+// Bvh8Watertight (8 wide, needs WideLeaves::kVertices); Slab or SlabRobust
+// (the conservative test: with the watertight leaves no ray leaks through
+// the tree, as bvh2:watertight:robust).
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <type_traits>
+
+#include "raybench/bvh/wide_bvh.h"
+#include "raybench/math/inline.h"
+
+namespace raybench {
+
+namespace wide_bvh_detail {
+// Each level pushes at most W - 1 entries beyond the one popped next; the
+// tree's depth bounds the levels. The SIMD pushes store W entries whatever
+// their count, hence the slack.
+inline constexpr std::size_t kMaxDepth = 128;  // BVH2 depth is bounded by 96 (bvh2_traverse.h)
+
+// The traversal stack, structure-of-arrays: node references and the entry
+// distance of each.
+template <int W>
+struct Stack {
+  static constexpr std::size_t kSize = (W - 1) * kMaxDepth + 2 * W;
+  alignas(32) std::uint32_t ref[kSize];
+  alignas(32) float entry[kSize];
+  int top = 0;
+};
+
+// Pushes the children of `node` in `lanes` (bit i: lane i) in the node's
+// far-to-near order for `octant`, lane by lane: the scalar form of the
+// compacted SIMD push below, same order.
+template <int W>
+inline void push_far_to_near_scalar(Stack<W>& stack, const WideNode<W>& node, int octant, unsigned lanes,
+                                    const float entry[W]) {
+  for (int rank = 0; rank < W; ++rank) {
+    const int lane = far_to_near_lane(node, octant, rank);
+    if (!(lanes >> lane & 1u)) continue;
+    stack.ref[stack.top] = node.child[lane];
+    stack.entry[stack.top] = entry[lane];
+    ++stack.top;
+  }
+}
+
+#if defined(__AVX2__)
+// kCompactLanes<W>[mask]: the set bits of mask in increasing order, 4 bits
+// each, lowest first: the permutation that packs the selected lanes to the front.
+template <int W>
+inline constexpr std::array<std::uint32_t, (1u << W)> kCompactLanes = [] {
+  std::array<std::uint32_t, (1u << W)> table{};
+  for (unsigned mask = 0; mask < (1u << W); ++mask) {
+    int k = 0;
+    for (unsigned lane = 0; lane < W; ++lane)
+      if (mask >> lane & 1u) table[mask] |= lane << (4 * k++);
+  }
+  return table;
+}();
+
+// Unpacks W fields of `Bits` bits each from `packed` into the W lanes.
+template <int W, int Bits>
+inline simd::IntLanes<W> unpack_lanes(std::uint32_t packed) {
+  using I = simd::IntLanes<W>;
+  return I::set1(packed).shift_right(I::iota(Bits)) & I::set1((1u << Bits) - 1);
+}
+
+// Pushes the lanes of `refs`/`entry` selected by `lanes`, keeping their order.
+template <int W>
+inline void push_compacted(Stack<W>& stack, simd::IntLanes<W> refs, simd::FloatLanes<W> entry, unsigned lanes) {
+  const simd::IntLanes<W> pick = unpack_lanes<W, 4>(kCompactLanes<W>[lanes]);
+  refs.permute(pick).storeu(stack.ref + stack.top);
+  entry.permute(pick).storeu(stack.entry + stack.top);
+  stack.top += __builtin_popcount(lanes);
+}
+#endif
+}  // namespace wide_bvh_detail
+
+struct WideMollerTrumbore {
+  static constexpr WideLeaves kLeaves = WideLeaves::kMollerTrumbore;  // what collapse_bvh2 must store
+  using RayData = Ray;
+  static RayData precompute(const Ray& ray) { return ray; }
+  template <int W>
+  static int intersect(const RayData& ray, float tmax, const WideBvh<W>& bvh, std::uint32_t pack, TriangleHit& out) {
+    return intersect_pack(ray, tmax, bvh.packs[pack], out);
+  }
+};
+
+struct Bvh8Watertight {
+  static constexpr WideLeaves kLeaves = WideLeaves::kVertices;
+  using RayData = WatertightTriangle::RayData;
+  static RayData precompute(const Ray& ray) { return WatertightTriangle::precompute(ray); }
+  static int intersect(const RayData& ray, float tmax, const Bvh8& bvh, std::uint32_t pack, TriangleHit& out) {
+    return intersect8_watertight(ray, tmax, bvh.vertex_packs[pack], out);
+  }
+};
+
+template <bool AnyHit, typename Leaf = WideMollerTrumbore, typename BoxTest = Slab, int W>
+inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
+  Hit hit;
+  if (bvh.nodes.empty()) return hit;
+  const Slab::Precomputed r = Slab::precompute(ray);
+  const int octant = ray_octant(r);
+  const typename Leaf::RayData leaf_ray = Leaf::precompute(ray);
+  // A popped subtree farther than the current hit is skipped; the robust
+  // test compares with the padded bound, so it never skips what it entered.
+  const auto reachable = [](float entry, float tmax) {
+    if constexpr (std::is_same_v<BoxTest, SlabRobust>) return entry <= tmax + std::fabs(tmax) * SlabRobust::kPad;
+    else return entry <= tmax;
+  };
+  float tmax = ray.tfar;
+  wide_bvh_detail::Stack<W> stack;
+  stack.ref[0] = 0;
+  stack.entry[0] = r.tnear;
+  stack.top = 1;
+  while (stack.top > 0) {
+    --stack.top;
+    const std::uint32_t ref = stack.ref[stack.top];
+    if (!reachable(stack.entry[stack.top], tmax)) continue;  // a hit closer than this subtree was found meanwhile
+    if (ref & WideBvh<W>::kLeafBit) {
+      const std::uint32_t pack = ref & ~WideBvh<W>::kLeafBit;
+      TriangleHit th;
+      const int lane = Leaf::intersect(leaf_ray, tmax, bvh, pack, th);
+      if (lane >= 0) {
+        tmax = th.t;
+        hit = {th.t, bvh.pack_prims[W * pack + static_cast<std::uint32_t>(lane)], th.u, th.v};
+        if (AnyHit) return hit;
+      }
+      continue;
+    }
+    const WideNode<W>& node = bvh.nodes[ref];
+#if defined(__AVX2__)
+    // Permute the node's lanes into far-to-near order, then push the entered
+    // ones compacted (for any hit: inner nodes first, leaves on top; the leaf
+    // bit is the sign bit).
+    const BoxHits<W> box = slab_lanes<BoxTest>(r, tmax, node.bounds);
+    const simd::IntLanes<W> order =
+        wide_bvh_detail::unpack_lanes<W, WideNode<W>::kOrderBits>(node.far_to_near[octant]);
+    const unsigned entered = box.hit.permute(order).mask();
+    if (!entered) continue;
+    const simd::IntLanes<W> refs = simd::IntLanes<W>::load(node.child).permute(order);
+    const simd::FloatLanes<W> entry = box.t_entry.permute(order);
+    if constexpr (AnyHit) {
+      const unsigned leaves = refs.sign_mask();
+      wide_bvh_detail::push_compacted(stack, refs, entry, entered & ~leaves);
+      wide_bvh_detail::push_compacted(stack, refs, entry, entered & leaves);
+    } else {
+      wide_bvh_detail::push_compacted(stack, refs, entry, entered);
+    }
+#else
+    alignas(32) float entry[W];
+    const unsigned entered = intersect_boxes<BoxTest>(r, tmax, node.bounds, entry);
+    if constexpr (AnyHit) {
+      unsigned leaves = 0;
+      for (int lane = 0; lane < W; ++lane)
+        leaves |= static_cast<unsigned>((node.child[lane] & WideBvh<W>::kLeafBit) != 0) << lane;
+      wide_bvh_detail::push_far_to_near_scalar(stack, node, octant, entered & ~leaves, entry);
+      wide_bvh_detail::push_far_to_near_scalar(stack, node, octant, entered & leaves, entry);
+    } else {
+      wide_bvh_detail::push_far_to_near_scalar(stack, node, octant, entered, entry);
+    }
+#endif
+  }
+  return hit;
+}
+
+template <typename Leaf = WideMollerTrumbore, typename BoxTest = Slab, int W>
+inline Hit intersect_wide(const WideBvh<W>& bvh, const Ray& ray) {
+  return traverse_wide<false, Leaf, BoxTest>(bvh, ray);
+}
+template <typename Leaf = WideMollerTrumbore, typename BoxTest = Slab, int W>
+inline bool occluded_wide(const WideBvh<W>& bvh, const Ray& ray) {
+  return traverse_wide<true, Leaf, BoxTest>(bvh, ray).hit();
+}
+
+}  // namespace raybench

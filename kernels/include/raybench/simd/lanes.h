@@ -1,0 +1,102 @@
+// W float or int lanes in one register, for the wide kernels written once for
+// every width: FloatLanes<8>/IntLanes<8> are AVX2's __m256/__m256i,
+// FloatLanes<4>/IntLanes<4> SSE's __m128/__m128i (with AVX2's variable
+// shifts and permutes). Thin wrappers: each operation is one intrinsic, so
+// the wide box and triangle tests compile as if written with intrinsics.
+// Comparisons are ordered and non-signalling (false for NaN), and min/max
+// return their second operand when either is NaN, as the scalar kernels'
+// comparisons do. Only with AVX2 (raybench::kHaveAvx2); without it the wide
+// kernels run their scalar forms.
+#pragma once
+
+#include <cstdint>
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+
+namespace raybench::simd {
+
+template <int W>
+struct FloatLanes;
+template <int W>
+struct IntLanes;
+
+template <>
+struct IntLanes<8> {
+  __m256i v;
+  static IntLanes set1(std::uint32_t x) { return {_mm256_set1_epi32(static_cast<int>(x))}; }
+  static IntLanes load(const std::uint32_t* p) { return {_mm256_load_si256(reinterpret_cast<const __m256i*>(p))}; }
+  static IntLanes iota(int step) { return {_mm256_setr_epi32(0, step, 2 * step, 3 * step, 4 * step, 5 * step, 6 * step, 7 * step)}; }
+  void storeu(std::uint32_t* p) const { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), v); }
+  IntLanes shift_right(IntLanes by) const { return {_mm256_srlv_epi32(v, by.v)}; }
+  IntLanes operator&(IntLanes o) const { return {_mm256_and_si256(v, o.v)}; }
+  // Lane i of the result is lane index[i] of this.
+  IntLanes permute(IntLanes index) const { return {_mm256_permutevar8x32_epi32(v, index.v)}; }
+  // Bit i set when lane i's sign bit is.
+  unsigned sign_mask() const { return static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(v))); }
+};
+
+template <>
+struct FloatLanes<8> {
+  __m256 v;
+  static FloatLanes set1(float x) { return {_mm256_set1_ps(x)}; }
+  static FloatLanes load(const float* p) { return {_mm256_load_ps(p)}; }
+  void storeu(float* p) const { _mm256_storeu_ps(p, v); }
+  FloatLanes operator+(FloatLanes o) const { return {_mm256_add_ps(v, o.v)}; }
+  FloatLanes operator-(FloatLanes o) const { return {_mm256_sub_ps(v, o.v)}; }
+  FloatLanes operator*(FloatLanes o) const { return {_mm256_mul_ps(v, o.v)}; }
+  FloatLanes operator/(FloatLanes o) const { return {_mm256_div_ps(v, o.v)}; }
+  FloatLanes operator&(FloatLanes o) const { return {_mm256_and_ps(v, o.v)}; }
+  FloatLanes operator<=(FloatLanes o) const { return {_mm256_cmp_ps(v, o.v, _CMP_LE_OQ)}; }
+  FloatLanes operator<(FloatLanes o) const { return {_mm256_cmp_ps(v, o.v, _CMP_LT_OQ)}; }
+  FloatLanes operator>=(FloatLanes o) const { return {_mm256_cmp_ps(v, o.v, _CMP_GE_OQ)}; }
+  FloatLanes operator>(FloatLanes o) const { return {_mm256_cmp_ps(v, o.v, _CMP_GT_OQ)}; }
+  FloatLanes operator!=(FloatLanes o) const { return {_mm256_cmp_ps(v, o.v, _CMP_NEQ_OQ)}; }
+  FloatLanes abs() const { return {_mm256_andnot_ps(_mm256_set1_ps(-0.0f), v)}; }
+  FloatLanes permute(IntLanes<8> index) const { return {_mm256_permutevar8x32_ps(v, index.v)}; }
+  unsigned mask() const { return static_cast<unsigned>(_mm256_movemask_ps(v)); }
+};
+// max(a, b) / min(a, b): b when either is NaN.
+inline FloatLanes<8> max(FloatLanes<8> a, FloatLanes<8> b) { return {_mm256_max_ps(a.v, b.v)}; }
+inline FloatLanes<8> min(FloatLanes<8> a, FloatLanes<8> b) { return {_mm256_min_ps(a.v, b.v)}; }
+
+template <>
+struct IntLanes<4> {
+  __m128i v;
+  static IntLanes set1(std::uint32_t x) { return {_mm_set1_epi32(static_cast<int>(x))}; }
+  static IntLanes load(const std::uint32_t* p) { return {_mm_load_si128(reinterpret_cast<const __m128i*>(p))}; }
+  static IntLanes iota(int step) { return {_mm_setr_epi32(0, step, 2 * step, 3 * step)}; }
+  void storeu(std::uint32_t* p) const { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), v); }
+  IntLanes shift_right(IntLanes by) const { return {_mm_srlv_epi32(v, by.v)}; }
+  IntLanes operator&(IntLanes o) const { return {_mm_and_si128(v, o.v)}; }
+  IntLanes permute(IntLanes index) const {
+    return {_mm_castps_si128(_mm_permutevar_ps(_mm_castsi128_ps(v), index.v))};
+  }
+  unsigned sign_mask() const { return static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(v))); }
+};
+
+template <>
+struct FloatLanes<4> {
+  __m128 v;
+  static FloatLanes set1(float x) { return {_mm_set1_ps(x)}; }
+  static FloatLanes load(const float* p) { return {_mm_load_ps(p)}; }
+  void storeu(float* p) const { _mm_storeu_ps(p, v); }
+  FloatLanes operator+(FloatLanes o) const { return {_mm_add_ps(v, o.v)}; }
+  FloatLanes operator-(FloatLanes o) const { return {_mm_sub_ps(v, o.v)}; }
+  FloatLanes operator*(FloatLanes o) const { return {_mm_mul_ps(v, o.v)}; }
+  FloatLanes operator/(FloatLanes o) const { return {_mm_div_ps(v, o.v)}; }
+  FloatLanes operator&(FloatLanes o) const { return {_mm_and_ps(v, o.v)}; }
+  FloatLanes operator<=(FloatLanes o) const { return {_mm_cmp_ps(v, o.v, _CMP_LE_OQ)}; }
+  FloatLanes operator<(FloatLanes o) const { return {_mm_cmp_ps(v, o.v, _CMP_LT_OQ)}; }
+  FloatLanes operator>=(FloatLanes o) const { return {_mm_cmp_ps(v, o.v, _CMP_GE_OQ)}; }
+  FloatLanes operator>(FloatLanes o) const { return {_mm_cmp_ps(v, o.v, _CMP_GT_OQ)}; }
+  FloatLanes operator!=(FloatLanes o) const { return {_mm_cmp_ps(v, o.v, _CMP_NEQ_OQ)}; }
+  FloatLanes abs() const { return {_mm_andnot_ps(_mm_set1_ps(-0.0f), v)}; }
+  FloatLanes permute(IntLanes<4> index) const { return {_mm_permutevar_ps(v, index.v)}; }
+  unsigned mask() const { return static_cast<unsigned>(_mm_movemask_ps(v)); }
+};
+inline FloatLanes<4> max(FloatLanes<4> a, FloatLanes<4> b) { return {_mm_max_ps(a.v, b.v)}; }
+inline FloatLanes<4> min(FloatLanes<4> a, FloatLanes<4> b) { return {_mm_min_ps(a.v, b.v)}; }
+
+}  // namespace raybench::simd
+#endif
