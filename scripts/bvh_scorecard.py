@@ -46,11 +46,11 @@ def same_triangle(row):
     return min(1.0, row["agree_prim"] + (row["prim_ties"] or 0) / both) if both else None
 
 
-def scorecard(rows):
-    """Per (scene, rayset): the numbers of the table; plus the overall verdicts."""
+def scorecard(rows, threads=1):
+    """Per (scene, rayset), at one thread count: the numbers of the table."""
     by = {}
     for r in rows:
-        if r["threads"] == 1 and r["rayset"] in RAYSETS and r["mrays_s"]:
+        if r["threads"] == threads and r["rayset"] in RAYSETS and r["mrays_s"]:
             by.setdefault((r["scene"], r["rayset"]), {})[r["backend"]] = r
     lines = []
     for (scene, rayset), backends in by.items():
@@ -71,6 +71,7 @@ def scorecard(rows):
             "watertight": wt_name,
             "watertight_ratio": wt["mrays_s"] / default["mrays_s"] if wt and default else None,
             "build_ratio": builder["build_ms"] / default["build_ms"] if builder and default and default["build_ms"] else None,
+            "build_ms": builder["build_ms"] if builder else None,
             "agree_hit": best["agree_hit"], "same_triangle": same_triangle(best),
         })
     return lines
@@ -80,7 +81,43 @@ def verdict(ok):
     return "**met**" if ok else "**missed**"
 
 
-def render(lines, meta, source):
+def render_threads(rows, lines):
+    """With more threads (rows with threads > 1): our best / Embree's best per ray set, and the default
+    build against Embree's medium build and against our own single-thread build."""
+    counts = sorted({r["threads"] for r in rows if r["threads"] and r["threads"] > 1})
+    out = []
+    one = {(x["scene"], x["rayset"]): x for x in lines}
+    for t in counts:
+        many = scorecard(rows, t)
+        if not many:
+            continue
+        out += ["", f"## With {t:g} threads", "",
+                "TBB threads trace the same chunks of rays for Embree and ours; Embree builds with the same thread count.",
+                "", f"| scene | ray set | our best | ratio, {t:g} threads | ratio, 1 thread | build / embree, {t:g} threads "
+                "| our build, 1 → {:g} threads |".format(t), "|---|---|---|---:|---:|---:|---:|"]
+        speedups = []
+        for x in many:
+            base = one.get((x["scene"], x["rayset"]))
+            speedup = base["build_ms"] / x["build_ms"] if base and base.get("build_ms") and x["build_ms"] else None
+            if speedup and x["rayset"] == RAYSETS[0]:
+                speedups.append(speedup)
+            out.append(f"| {x['scene']} | {x['rayset']} | {x['best']} | {x['ratio']:.2f} | "
+                       f"{'-' if not base else format(base['ratio'], '.2f')} | "
+                       f"{'-' if x['build_ratio'] is None else format(x['build_ratio'], '.2f')} | "
+                       f"{'-' if speedup is None else format(speedup, '.2f') + '×'} |")
+        ratios = [x["ratio"] for x in many]
+        builds = [x["build_ratio"] for x in many if x["build_ratio"] is not None]
+        out += ["", f"Geometric mean of our best / Embree's best with {t:g} threads: {geomean(ratios):.2f}."]
+        if builds:
+            out.append(f"Default build with {t:g} threads / Embree medium with {t:g} threads: max {max(builds):.2f} "
+                       f"({verdict(max(builds) <= 1.0)} ≤ 1.0).")
+        if speedups:
+            out.append(f"Our default build, 1 → {t:g} threads: {min(speedups):.2f}–{max(speedups):.2f}× faster "
+                       f"({verdict(min(speedups) > 1.0)}: faster on every scene).")
+    return out
+
+
+def render(lines, meta, source, rows=()):
     out = [f"# BVH scorecard: ours against Embree (issue 4)", "",
            f"From `{os.path.basename(source)}`, one thread, ratios within the run."]
     m = meta.get("machine", {}) if isinstance(meta.get("machine"), dict) else {}
@@ -121,6 +158,7 @@ def render(lines, meta, source):
         out.append(f"| hit/miss agreement ≥ 99.99 % | min {100 * min(agree):.3f} % | {verdict(min(agree) >= 0.9999)} |")
     if same:
         out.append(f"| same triangle ≥ 99.9 % (ties agree) | min {100 * min(same):.2f} % | {verdict(min(same) >= 0.999)} |")
+    out += render_threads(rows, lines)
     return "\n".join(out) + "\n"
 
 
@@ -134,7 +172,7 @@ def main(argv=None):
         lines = scorecard(rows)
         if not lines:
             raise InputError(args.results, "no single-thread primary, diffuse or shadow rows with both Embree and one of our backends")
-        text = render(lines, read_meta(args.results), args.results)
+        text = render(lines, read_meta(args.results), args.results, rows)
     except InputError as e:
         print(f"bvh-scorecard: error: {e}", file=sys.stderr)
         return 2

@@ -42,6 +42,21 @@ class Scorecard(unittest.TestCase):
         self.assertIn("| default build ≤ 1.0 × Embree medium | max 0.80 | **met** |", out)
         self.assertIn("| watertight ≥ 1.0 × Embree's default mode | min 1.10 | **met** |", out)
 
+    def test_rows_with_more_threads_get_their_own_section_with_the_build_speed_up(self):
+        rows = [row("a", "primary", "embree", 10.0, build=100), row("a", "primary", "bvh8", 9.0, build=120),
+                row("a", "primary", "embree", 18.0, build=60, threads=2), row("a", "primary", "bvh8", 19.8, build=66,
+                                                                                threads=2)]
+        result = self.run_on(rows)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        out = result.stdout
+        self.assertIn("## With 2 threads", out)
+        # 19.8 / 18 at 2 threads beside 0.90 at one; build 66 / 60; our build 120 -> 66 ms.
+        self.assertIn("| a | primary | bvh8 | 1.10 | 0.90 | 1.10 | 1.82× |", out)
+        self.assertIn("Default build with 2 threads / Embree medium with 2 threads: max 1.10 (**missed** ≤ 1.0).", out)
+        self.assertIn("Our default build, 1 → 2 threads: 1.82–1.82× faster (**met**: faster on every scene).", out)
+        # The single-thread table is unchanged by the 2-thread rows.
+        self.assertIn("| a | primary | embree | 10.00 | bvh8 | 9.00 | 0.90 |", out)
+
     def test_a_slower_scene_misses_the_per_scene_target(self):
         rows = [row("a", "primary", "embree", 10.0), row("a", "primary", "bvh2", 9.0, agree_prim="0.99", ties="5")]
         out = self.run_on(rows).stdout
