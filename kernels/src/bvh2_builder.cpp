@@ -21,13 +21,9 @@ struct PrimRef {
   std::uint32_t id;
 };
 
-struct Split {
-  int axis = -1;
-  int bin = 0;  // primitives in bins [0, bin] go left
-  float cost = std::numeric_limits<float>::infinity();
-};
-
-constexpr int kMaxBins = 64;
+using bvh2_build::centroid_bin;
+using bvh2_build::kMaxBins;
+using bvh2_build::ObjectSplit;
 
 class Builder {
  public:
@@ -50,8 +46,12 @@ class Builder {
     };
     if (count <= 1) return make_leaf();
 
-    const Split split = depth < options_.max_sah_depth ? find_split(begin, end, centroid_bounds) : Split{};
-    const float leaf_cost = tests(count);
+    const ObjectSplit split = depth < options_.max_sah_depth
+                                  ? bvh2_build::find_object_split(std::span<const PrimRef>(refs_.data() + begin, count),
+                                                                  centroid_bounds, bins_, options_.leaf_granularity,
+                                                                  [](const PrimRef& r) { return r.centroid; })
+                                  : ObjectSplit{};
+    const float leaf_cost = bvh2_build::leaf_tests(count, options_.leaf_granularity);
     std::size_t middle;
     if (split.axis < 0) {
       // All centroids coincide (e.g. duplicated or degenerate triangles), or the
@@ -64,8 +64,9 @@ class Builder {
       const int axis = split.axis;
       const float lo = centroid_bounds.lower[axis];
       const float scale = bins_ / (centroid_bounds.upper[axis] - lo);
-      auto* mid = std::partition(refs_.data() + begin, refs_.data() + end,
-                                 [&](const PrimRef& r) { return bin_of(r.centroid[axis], lo, scale) <= split.bin; });
+      auto* mid = std::partition(refs_.data() + begin, refs_.data() + end, [&](const PrimRef& r) {
+        return centroid_bin(r.centroid[axis], lo, scale, bins_) <= split.bin;
+      });
       middle = static_cast<std::size_t>(mid - refs_.data());
       if (middle == begin || middle == end) middle = begin + count / 2;  // float rounding put all on one side
     }
@@ -80,53 +81,6 @@ class Builder {
   std::uint32_t node_count() const { return next_node_.load(); }
 
  private:
-  // Leaf tests for n triangles, in units of one triangle test.
-  float tests(std::size_t n) const {
-    const auto g = static_cast<std::size_t>(std::max(1, options_.leaf_granularity));
-    return static_cast<float>((n + g - 1) / g);
-  }
-
-  int bin_of(float c, float lo, float scale) const {
-    const int b = static_cast<int>((c - lo) * scale);
-    return std::clamp(b, 0, bins_ - 1);
-  }
-
-  Split find_split(std::size_t begin, std::size_t end, const BBox& centroid_bounds) const {
-    const int bins = bins_;
-    Split best;
-    for (int axis = 0; axis < 3; ++axis) {
-      const float lo = centroid_bounds.lower[axis];
-      const float extent = centroid_bounds.upper[axis] - lo;
-      if (!(extent > 0.0f)) continue;
-      const float scale = bins / extent;
-      std::array<BBox, kMaxBins> bin_bounds{};
-      std::array<std::size_t, kMaxBins> bin_count{};
-      for (std::size_t i = begin; i < end; ++i) {
-        const int b = bin_of(refs_[i].centroid[axis], lo, scale);
-        bin_bounds[b].extend(refs_[i].bounds);
-        ++bin_count[b];
-      }
-      // Sweep from the right to get the right-hand cost of every split plane.
-      std::array<float, kMaxBins> right_cost{};
-      BBox acc;
-      std::size_t n = 0;
-      for (int b = bins - 1; b > 0; --b) {
-        acc.extend(bin_bounds[b]);
-        n += bin_count[b];
-        right_cost[b] = acc.half_area() * tests(n);
-      }
-      acc = BBox{};
-      n = 0;
-      for (int b = 0; b < bins - 1; ++b) {
-        acc.extend(bin_bounds[b]);
-        n += bin_count[b];
-        const float cost = acc.half_area() * tests(n) + right_cost[b + 1];
-        if (n > 0 && n < end - begin && cost < best.cost) best = {axis, b, cost};
-      }
-    }
-    return best;
-  }
-
   std::vector<PrimRef>& refs_;
   std::vector<Bvh2Node>& nodes_;
   const Bvh2BuildOptions& options_;

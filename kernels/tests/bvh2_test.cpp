@@ -50,19 +50,37 @@ int depth_of(const Bvh2& bvh) {
   return deepest;
 }
 
-void expect_valid(const Bvh2& bvh, const std::vector<Triangle>& tris, const Bvh2BuildOptions& options = {}) {
-  std::vector<int> seen(tris.size(), 0);
+// The structural specification of every builder. Each leaf's triangles are
+// distinct. A builder that does not split triangles (splits_triangles)
+// places each one in exactly one leaf, whose box contains it; the SBVH
+// places each in at least one leaf, each such leaf's box meets the
+// triangle's box, and their union covers the triangle (so no hit is lost),
+// with at most spatial_split_budget * n extra references. Inner boxes
+// contain their children's; the depth stays within the documented bound.
+void expect_valid(const Bvh2& bvh, const std::vector<Triangle>& tris, bool splits,
+                  const Bvh2BuildOptions& options = {}) {
+  std::vector<std::vector<BBox>> leaves_of(tris.size());  // the boxes of the leaves holding each triangle
   std::vector<std::uint32_t> stack{0};
   while (!stack.empty()) {
     const Bvh2Node& n = bvh.nodes[stack.back()];
     stack.pop_back();
     if (n.is_leaf()) {
       ASSERT_LE(n.first_index + n.prim_count, bvh.prim_ids.size());
-      for (std::uint32_t i = n.first_index; i < n.first_index + n.prim_count; ++i) {
-        const std::uint32_t id = bvh.prim_ids[i];
+      std::vector<std::uint32_t> ids(bvh.prim_ids.begin() + n.first_index,
+                                     bvh.prim_ids.begin() + n.first_index + n.prim_count);
+      std::sort(ids.begin(), ids.end());
+      EXPECT_EQ(std::adjacent_find(ids.begin(), ids.end()), ids.end()) << "a triangle twice in one leaf";
+      for (const std::uint32_t id : ids) {
         ASSERT_LT(id, tris.size());
-        ++seen[id];
-        EXPECT_TRUE(n.bounds.contains(bounds_of(tris[id]))) << "leaf does not contain triangle " << id;
+        leaves_of[id].push_back(n.bounds);
+        if (splits) {
+          BBox meet = n.bounds;
+          meet.lower = max(meet.lower, bounds_of(tris[id]).lower);
+          meet.upper = min(meet.upper, bounds_of(tris[id]).upper);
+          EXPECT_FALSE(meet.empty()) << "a leaf holds triangle " << id << " but none of it";
+        } else {
+          EXPECT_TRUE(n.bounds.contains(bounds_of(tris[id]))) << "leaf does not contain triangle " << id;
+        }
       }
     } else {
       for (std::uint32_t c : {n.first_index, n.first_index + 1}) {
@@ -72,7 +90,23 @@ void expect_valid(const Bvh2& bvh, const std::vector<Triangle>& tris, const Bvh2
       }
     }
   }
-  for (std::size_t i = 0; i < tris.size(); ++i) EXPECT_EQ(seen[i], 1) << "triangle " << i << " in " << seen[i] << " leaves";
+  for (std::size_t i = 0; i < tris.size(); ++i) {
+    const std::size_t seen = leaves_of[i].size();
+    if (!splits) {
+      EXPECT_EQ(seen, 1u) << "triangle " << i << " in " << seen << " leaves";
+      continue;
+    }
+    EXPECT_GE(seen, 1u) << "triangle " << i << " in no leaf";
+    const auto hole = testing::uncovered_point(tris[i], leaves_of[i]);
+    EXPECT_FALSE(hole.has_value()) << "triangle " << i << " (in " << seen << " leaves) is not covered at ("
+                                   << (*hole)[0] << ", " << (*hole)[1] << ", " << (*hole)[2] << ")";
+  }
+  if (splits) {
+    EXPECT_LE(static_cast<double>(bvh.prim_ids.size()),
+              static_cast<double>(tris.size()) * (1.0 + options.spatial_split_budget));
+  } else {
+    EXPECT_EQ(bvh.prim_ids.size(), tris.size());
+  }
   EXPECT_TRUE(std::isfinite(bvh.sah_cost()));
   EXPECT_GT(bvh.sah_cost(), 0.0);
   // The documented bound (bvh2.h), which kBvh2StackSize covers.
@@ -113,9 +147,13 @@ class Bvh2Build : public ::testing::TestWithParam<Bvh2Builder> {
   Bvh2 build(const std::vector<Triangle>& tris, const Bvh2BuildOptions& options = {}) const {
     return build_bvh2(tris, GetParam(), options);
   }
+  void expect_valid(const Bvh2& bvh, const std::vector<Triangle>& tris, const Bvh2BuildOptions& options = {}) const {
+    raybench::expect_valid(bvh, tris, splits_triangles(GetParam()), options);
+  }
 };
 
-TEST_P(Bvh2Build, EveryTriangleInExactlyOneLeafAndBoundsNest) {
+// Exactly one leaf per triangle, or (SBVH) leaves that together cover it.
+TEST_P(Bvh2Build, EveryTriangleIsInALeafAndItsLeavesCoverItAndBoundsNest) {
   const auto tris = random_soup(5000, 1);
   expect_valid(build(tris), tris);
   Bvh2BuildOptions packs;
@@ -181,6 +219,46 @@ TEST_P(Bvh2Build, DepthStaysWithinTheTraversalStackOnAdversarialInput) {
   const std::vector<Triangle> largest(tris.begin(), tris.begin() + 20);
   const auto rays = rays_at(largest, "aimed", 500, 9);
   EXPECT_GT(expect_same_hits_as_brute_force(bvh, tris, rays), 400);
+}
+
+TEST_P(Bvh2Build, NonFiniteTrianglesNeitherCrashNorLoopAndStayInTheTree) {
+  // A broken mesh: NaN and infinite coordinates, and a finite triangle whose
+  // box's extent overflows. No builder may crash, loop or drop a triangle
+  // (the SBVH does not clip non-finite ones; it still clips the rest).
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN(), kInf = std::numeric_limits<float>::infinity();
+  auto tris = random_soup(2000, 15);
+  tris.push_back({{kNaN, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+  tris.push_back({{kNaN, kNaN, kNaN}, {kNaN, kNaN, kNaN}, {kNaN, kNaN, kNaN}});
+  tris.push_back({{0, 0, 0}, {kInf, 0, 0}, {0, 1, 0}});
+  tris.push_back({{-kInf, 0, 0}, {kInf, 1, 0}, {0, -kInf, 1}});
+  tris.push_back({{-3e38f, 0, 0}, {3e38f, 1, 0}, {0, 3e38f, 1}});
+  for (const Bvh2BuildOptions& options : {Bvh2BuildOptions{}, Bvh2BuildOptions{.leaf_granularity = 8}}) {
+    const Bvh2 bvh = build(tris, options);
+    std::vector<std::vector<BBox>> leaves_of(tris.size());
+    std::vector<std::uint32_t> stack{0};
+    while (!stack.empty()) {
+      const Bvh2Node& n = bvh.nodes[stack.back()];
+      stack.pop_back();
+      if (!n.is_leaf()) {
+        stack.push_back(n.first_index);
+        stack.push_back(n.first_index + 1);
+        continue;
+      }
+      for (std::uint32_t i = n.first_index; i < n.first_index + n.prim_count; ++i)
+        leaves_of[bvh.prim_ids[i]].push_back(n.bounds);
+    }
+    for (std::size_t i = 0; i < tris.size(); ++i) {
+      if (splits_triangles(GetParam())) {
+        EXPECT_GE(leaves_of[i].size(), 1u) << "triangle " << i;
+      } else {
+        EXPECT_EQ(leaves_of[i].size(), 1u) << "triangle " << i;
+      }
+      if (is_finite(tris[i].v0) && is_finite(tris[i].v1) && is_finite(tris[i].v2)) {
+        EXPECT_FALSE(testing::uncovered_point(tris[i], leaves_of[i]).has_value()) << "triangle " << i;
+      }
+    }
+    EXPECT_LE(depth_of(bvh), options.max_sah_depth + 32);
+  }
 }
 
 TEST_P(Bvh2Build, ClosestHitMatchesBruteForce) {
@@ -359,6 +437,65 @@ TEST(Bvh2Quality, LbvhIsFiniteAndWithinTwiceTheSweepsCost) {
   }
 }
 
+// Small triangles (the soup in [-10, 10]^3) crossed by a fan of 256 long
+// thin triangles through the centre, diagonally out to the soup's corners:
+// each sliver's box is most of the scene and nearly empty, so no object
+// split keeps them out of large boxes; what spatial splits are for.
+std::vector<Triangle> soup_with_a_fan_of_slivers() {
+  auto tris = random_soup(3000, 13);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int i = 0; i < 256; ++i) {
+    const Vec3f d = normalize(Vec3f{u(rng), u(rng), u(rng)});
+    const Vec3f side = normalize(cross(d, Vec3f{0.3f, 0.5f, 0.8f})) * 0.05f;
+    tris.push_back({d * -9.0f, d * 9.0f, d * -9.0f + side});
+  }
+  return tris;
+}
+
+TEST(Bvh2Quality, SpatialSplitsLowerTheCostOfLongThinOverlappingTrianglesWithinTheBudget) {
+  // Measured: the SBVH costs 0.53x (one at a time) and 0.63x (packs of 8)
+  // the binned tree here with the default budget (1.42x references), 0.71x
+  // and 0.78x with a budget of 0.1; 0.9 still demands a real gain.
+  const auto tris = soup_with_a_fan_of_slivers();
+  for (int g : {1, 8}) {
+    for (float budget : {0.5f, 0.1f}) {
+      SCOPED_TRACE(::testing::Message() << "leaf granularity " << g << ", budget " << budget);
+      Bvh2BuildOptions options;
+      options.leaf_granularity = g;
+      options.spatial_split_budget = budget;
+      const Bvh2 sbvh = build_bvh2_sbvh(tris, options), binned = build_bvh2_binned_sah(tris, options);
+      EXPECT_LT(sbvh.sah_cost(g), binned.sah_cost(g) * 0.9);
+      EXPECT_GT(sbvh.prim_ids.size(), tris.size()) << "no triangle was split";
+      expect_valid(sbvh, tris, true, options);  // within the budget, among the rest
+    }
+  }
+  // No budget: spatial splits may still partition, but duplicate nothing.
+  Bvh2BuildOptions none;
+  none.spatial_split_budget = 0.0f;
+  const Bvh2 sbvh = build_bvh2_sbvh(tris, none);
+  EXPECT_EQ(sbvh.prim_ids.size(), tris.size());
+  expect_valid(sbvh, tris, true, none);
+  const auto rays = rays_at(tris, "random", 2000, 18);
+  EXPECT_GT(expect_same_hits_as_brute_force(build_bvh2_sbvh(tris), tris, rays), 200);
+}
+
+TEST(Bvh2Quality, TheSbvhIsAtLeastAsGoodAsBinningOnMeshesAndSoups) {
+  // Binning's object splits are among its choices at every node, so each
+  // greedy choice is at least as cheap (0.5 % allowance for the greedy
+  // whole, as for the sweep). Measured: 1.3 % and 0.7 % cheaper on the soup,
+  // within 0.1 % either way on the spheres and the clusters (their boxes
+  // barely overlap, so spatial splits are seldom tried).
+  int input = 0;
+  for (const auto& tris : quality_inputs()) {
+    for (int g : {1, 8}) {
+      const double sbvh = sah_of(Bvh2Builder::kSbvh, tris, g), binned = sah_of(Bvh2Builder::kBinnedSah, tris, g);
+      EXPECT_LE(sbvh, binned * 1.005) << "input " << input << ", leaf granularity " << g;
+    }
+    ++input;
+  }
+}
+
 TEST(Bvh2Quality, SahCostCountsLeafTestsInPacksOfTheGranularity) {
   // One leaf of 9 triangles: 9 tests one at a time, 2 packs of 8.
   const auto tris = random_soup(7, 14);  // 7 + 2 degenerate
@@ -379,7 +516,8 @@ TEST(Bvh2Builders, NamesRoundTripAndUnknownNamesAreRejected) {
   EXPECT_EQ(parse_bvh2_builder("binned"), Bvh2Builder::kBinnedSah);
   EXPECT_EQ(parse_bvh2_builder("sweep"), Bvh2Builder::kSweepSah);
   EXPECT_EQ(parse_bvh2_builder("lbvh"), Bvh2Builder::kLbvh);
-  EXPECT_FALSE(parse_bvh2_builder("sbvh").has_value());
+  EXPECT_EQ(parse_bvh2_builder("sbvh"), Bvh2Builder::kSbvh);
+  EXPECT_FALSE(parse_bvh2_builder("spatial").has_value());
   EXPECT_FALSE(parse_bvh2_builder("").has_value());
 }
 

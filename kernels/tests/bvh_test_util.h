@@ -1,12 +1,19 @@
 // What the BVH tests share: a random triangle soup with degenerate members,
 // a small mesh with shared edges, rays of the kinds a renderer shoots at it,
-// and the brute-force closest hit every traversal is checked against.
+// the brute-force closest hit every traversal is checked against, and the
+// check that boxes cover a triangle (a spatial-split BVH's leaves).
 #pragma once
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 #include <string_view>
 #include <vector>
+
+#include "raybench/math/bbox.h"
 
 #include "raybench/geometry/uv_sphere.h"
 #include "raybench/prim/triangle_mt.h"
@@ -97,6 +104,54 @@ inline Hit brute_force_closest(const std::vector<Triangle>& tris, const Ray& ray
     }
   }
   return best;
+}
+
+// A point of triangle t that no box of `boxes` holds, if there is one among
+// the points that decide it: t's vertices, the points where its edges cross
+// the boxes' faces (where one box ends and the next must take over), and a
+// grid of 153 interior points, all in double. A point is held when a box
+// contains it within 2^-40 of t's largest coordinate: room for the double
+// rounding of the points, far below a float ulp, so a box rounded inward by
+// one ulp where it cuts t is caught. For finite triangles.
+inline std::optional<std::array<double, 3>> uncovered_point(const Triangle& t, const std::vector<BBox>& boxes) {
+  using P = std::array<double, 3>;
+  const P v[3] = {{t.v0.x, t.v0.y, t.v0.z}, {t.v1.x, t.v1.y, t.v1.z}, {t.v2.x, t.v2.y, t.v2.z}};
+  double largest = 0.0;
+  for (const P& p : v)
+    for (double c : p) largest = std::max(largest, std::fabs(c));
+  const double tol = std::ldexp(largest, -40);
+  const auto held = [&](const P& p) {
+    return std::any_of(boxes.begin(), boxes.end(), [&](const BBox& b) {
+      for (int a = 0; a < 3; ++a)
+        if (!(b.lower[a] - tol <= p[a] && p[a] <= b.upper[a] + tol)) return false;
+      return true;
+    });
+  };
+  std::vector<P> points(v, v + 3);
+  for (const BBox& b : boxes)
+    for (int axis = 0; axis < 3; ++axis)
+      for (const double plane : {static_cast<double>(b.lower[axis]), static_cast<double>(b.upper[axis])})
+        for (int e = 0; e < 3; ++e) {
+          const P& a = v[e];
+          const P& c = v[(e + 1) % 3];
+          if (!((a[axis] < plane && plane < c[axis]) || (c[axis] < plane && plane < a[axis]))) continue;
+          const double s = (plane - a[axis]) / (c[axis] - a[axis]);
+          P p;
+          for (int j = 0; j < 3; ++j) p[j] = a[j] + s * (c[j] - a[j]);
+          p[axis] = plane;
+          points.push_back(p);
+        }
+  constexpr int kGrid = 16;
+  for (int i = 0; i <= kGrid; ++i)
+    for (int j = 0; i + j <= kGrid; ++j) {
+      const double b1 = static_cast<double>(i) / kGrid, b2 = static_cast<double>(j) / kGrid;
+      P p;
+      for (int a = 0; a < 3; ++a) p[a] = v[0][a] * (1.0 - b1 - b2) + v[1][a] * b1 + v[2][a] * b2;
+      points.push_back(p);
+    }
+  for (const P& p : points)
+    if (!held(p)) return p;
+  return std::nullopt;
 }
 
 }  // namespace raybench::testing

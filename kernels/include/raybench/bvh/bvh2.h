@@ -49,13 +49,20 @@ struct Bvh2BuildOptions {
   // makes full leaves of 8 as cheap as leaves of 1. 1 for scalar leaves.
   int leaf_granularity = 1;
   std::size_t parallel_threshold = 4096;  // subtrees at least this large are built as TBB tasks
+  // SBVH only: spatial splits add at most this fraction of the triangle
+  // count in extra references (0.5: prim_ids holds at most 1.5 n entries).
+  float spatial_split_budget = 0.5f;
 };
 
-// Every builder places each triangle in exactly one leaf, degenerate ones
+// Every builder places each triangle in at least one leaf, degenerate ones
 // included, and keeps the depth within max_sah_depth + 32 (deeper ranges are
 // halved), so kBvh2StackSize bounds the traversal stack. The tree's shape is
 // deterministic for a given input; raybench/bvh/bvh2_builders.h selects one
-// by name.
+// by name. The object-split builders (binned, sweep, LBVH) place each
+// triangle in exactly one leaf, whose box contains it; the SBVH may place a
+// triangle in several leaves (prim_ids repeats it, at most once per leaf),
+// each leaf's box containing the part of the triangle assigned to it and the
+// union of those boxes covering the triangle, so no hit is lost.
 
 // Binned SAH, top-down, centroid binning on all three axes (bin_count bins).
 Bvh2 build_bvh2_binned_sah(std::span<const Triangle> triangles, const Bvh2BuildOptions& options = {});
@@ -71,5 +78,14 @@ Bvh2 build_bvh2_sweep_sah(std::span<const Triangle> triangles, const Bvh2BuildOp
 // most max_leaf_size become leaves when the SAH says a leaf is cheaper than
 // the best subtree (bin_count is ignored). Fast, lower quality.
 Bvh2 build_bvh2_lbvh(std::span<const Triangle> triangles, const Bvh2BuildOptions& options = {});
+
+// Spatial-split BVH (Stich, Friedrich & Dietrich, HPG 2009): binned object
+// splits as build_bvh2_binned_sah, plus binned spatial splits where the best
+// object split's children overlap (by more than 1e-5 of the root's area):
+// triangles straddling a split plane are clipped to either side, each part
+// with a tight box, or kept whole on one side where the SAH prefers that.
+// At most spatial_split_budget * n references are added. Lower SAH cost on
+// scenes of large or long thin overlapping triangles, slower to build.
+Bvh2 build_bvh2_sbvh(std::span<const Triangle> triangles, const Bvh2BuildOptions& options = {});
 
 }  // namespace raybench

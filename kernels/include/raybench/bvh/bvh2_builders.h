@@ -18,17 +18,19 @@ enum class Bvh2Builder {
   kBinnedSah,  // the default: fast, near the sweep's quality
   kSweepSah,   // the quality reference
   kLbvh,       // fastest to build, lowest quality
+  kSbvh,       // spatial splits: a triangle may be in several leaves
 };
 
-inline constexpr std::array<Bvh2Builder, 3> kBvh2Builders = {Bvh2Builder::kBinnedSah, Bvh2Builder::kSweepSah,
-                                                             Bvh2Builder::kLbvh};
+inline constexpr std::array<Bvh2Builder, 4> kBvh2Builders = {Bvh2Builder::kBinnedSah, Bvh2Builder::kSweepSah,
+                                                             Bvh2Builder::kLbvh, Bvh2Builder::kSbvh};
 
-// The option name: "binned", "sweep", "lbvh".
+// The option name: "binned", "sweep", "lbvh", "sbvh".
 constexpr std::string_view to_string(Bvh2Builder b) {
   switch (b) {
     case Bvh2Builder::kBinnedSah: return "binned";
     case Bvh2Builder::kSweepSah: return "sweep";
     case Bvh2Builder::kLbvh: return "lbvh";
+    case Bvh2Builder::kSbvh: return "sbvh";
   }
   return "?";
 }
@@ -38,8 +40,21 @@ constexpr std::string_view description(Bvh2Builder b) {
     case Bvh2Builder::kBinnedSah: return "binned SAH (16 bins, TBB-parallel)";
     case Bvh2Builder::kSweepSah: return "full-sweep SAH (every centroid split, the quality reference)";
     case Bvh2Builder::kLbvh: return "LBVH (63-bit Morton codes, splits at the highest differing bit)";
+    case Bvh2Builder::kSbvh: return "SBVH (binned SAH with spatial splits, Stich et al. 2009; at most 1.5x references)";
   }
   return "?";
+}
+
+// Whether the builder may place a triangle in several leaves (spatial
+// splits): prim_ids then repeats it, and its leaves' boxes together cover it.
+constexpr bool splits_triangles(Bvh2Builder b) {
+  switch (b) {
+    case Bvh2Builder::kSbvh: return true;
+    case Bvh2Builder::kBinnedSah:
+    case Bvh2Builder::kSweepSah:
+    case Bvh2Builder::kLbvh: return false;
+  }
+  return false;
 }
 
 // The builder named `name` (as to_string spells it), or nothing.
@@ -49,7 +64,7 @@ constexpr std::optional<Bvh2Builder> parse_bvh2_builder(std::string_view name) {
   return std::nullopt;
 }
 
-// "binned, sweep, lbvh": for help texts and error messages.
+// "binned, sweep, lbvh, sbvh": for help texts and error messages.
 inline std::string bvh2_builder_names() {
   std::string out;
   for (Bvh2Builder b : kBvh2Builders) out += (out.empty() ? "" : ", ") + std::string(to_string(b));
@@ -60,6 +75,7 @@ inline Bvh2 build_bvh2(std::span<const Triangle> triangles, Bvh2Builder builder,
   switch (builder) {
     case Bvh2Builder::kSweepSah: return build_bvh2_sweep_sah(triangles, options);
     case Bvh2Builder::kLbvh: return build_bvh2_lbvh(triangles, options);
+    case Bvh2Builder::kSbvh: return build_bvh2_sbvh(triangles, options);
     case Bvh2Builder::kBinnedSah: break;
   }
   return build_bvh2_binned_sah(triangles, options);
