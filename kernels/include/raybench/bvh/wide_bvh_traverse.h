@@ -130,7 +130,7 @@ inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
     if (!reachable(stack.entry[stack.top], tmax)) continue;  // a hit closer than this subtree was found meanwhile
     if (ref & WideBvh<W>::kLeafBit) {
       const std::uint32_t pack = ref & ~WideBvh<W>::kLeafBit;
-      TriangleHit th;
+      TriangleHit th{};  // set when a lane hits (initialised: the scalar fallback sets it conditionally)
       const int lane = Leaf::intersect(leaf_ray, tmax, bvh, pack, th);
       if (lane >= 0) {
         tmax = th.t;
