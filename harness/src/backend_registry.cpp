@@ -60,15 +60,16 @@ std::vector<BackendInfo> list_backends() {
 
 std::string backend_accuracy_class(const std::string& name) {
   const std::vector<BackendInfo> all = list_backends();
-  // A builder option (bvh2_builders.h) changes the tree, not the accuracy
-  // class, and may stand anywhere: "bvh2:lbvh:mt_seed" is in the class of
-  // "bvh2:mt_seed". Drop it before looking the name up.
+  // A builder option or 'reinsert' (bvh2_builders.h) changes the tree, not
+  // the accuracy class, and may stand anywhere: "bvh2:lbvh:mt_seed" and
+  // "bvh2:reinsert:mt_seed" are in the class of "bvh2:mt_seed". Drop it
+  // before looking the name up.
   std::string wanted;
   std::size_t start = 0;
   for (;;) {
     const std::size_t colon = name.find(':', start);
     const std::string part = name.substr(start, colon - start);
-    if (start == 0 || !parse_bvh2_builder(part)) wanted += (start == 0 ? "" : ":") + part;
+    if (start == 0 || !is_bvh2_tree_option(part)) wanted += (start == 0 ? "" : ":") + part;
     if (colon == std::string::npos) break;
     start = colon + 1;
   }

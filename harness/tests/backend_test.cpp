@@ -187,7 +187,8 @@ TEST(BackendNames, UnknownFamiliesAndOptionsAreErrorsThatSaySo) {
   EXPECT_NE(error_of("bvh2:magic").find("unknown option 'magic'"), std::string::npos);
   EXPECT_NO_THROW(make_backend("embree:high:robust"));
   EXPECT_NO_THROW(make_backend("bvh2:robust"));  // the default triangle test, robust traversal
-  EXPECT_NE(error_of("bvh2:mt:watertight").find("bvh2 takes a triangle test, a builder and 'robust', each at most once"),
+  EXPECT_NE(error_of("bvh2:mt:watertight")
+                .find("bvh2 takes a triangle test, a builder, 'robust' and 'reinsert', each at most once"),
             std::string::npos);
   EXPECT_NE(error_of("bvh2:sweep:lbvh").find("each at most once"), std::string::npos);
   EXPECT_NE(error_of("bvh2:robust:robust").find("each at most once"), std::string::npos);
@@ -195,10 +196,14 @@ TEST(BackendNames, UnknownFamiliesAndOptionsAreErrorsThatSaySo) {
   EXPECT_NE(error_of("bvh8:mt_seed").find("unknown option 'mt_seed'"), std::string::npos);  // no 8-wide seed kernel
   EXPECT_NE(error_of("bvh8:mt:watertight").find("each at most once"), std::string::npos);
   EXPECT_NE(error_of("bvh8:lbvh:sweep").find("each at most once"), std::string::npos);
+  EXPECT_NE(error_of("bvh2:reinsert:sweep:reinsert").find("each at most once"), std::string::npos);
+  EXPECT_NE(error_of("bvh8:reinsert:reinsert").find("each at most once"), std::string::npos);
   // The messages list what is valid.
   for (const char* bad : {"bvh2:magic", "bvh2:sweep:lbvh", "bvh8:magic", "bvh8:mt:mt"})
     EXPECT_NE(error_of(bad).find("builders: binned, sweep, lbvh"), std::string::npos) << bad;
   EXPECT_NE(error_of("bvh2:magic").find("triangle tests: mt, mt_seed, watertight"), std::string::npos);
+  for (const char* bad : {"bvh2:magic", "bvh8:magic", "bvh4:magic"})
+    EXPECT_NE(error_of(bad).find("reinsert"), std::string::npos) << bad;
 }
 
 TEST(BackendNames, BuildersAreOptionsOfBvh2AndBvh8InAnyOrder) {
@@ -214,6 +219,21 @@ TEST(BackendNames, BuildersAreOptionsOfBvh2AndBvh8InAnyOrder) {
   EXPECT_EQ(backend_accuracy_class("bvh2:watertight:robust:lbvh"), "watertight");
   EXPECT_EQ(backend_accuracy_class("bvh2:lbvh:mt_seed"), "epsilon");
   EXPECT_EQ(backend_accuracy_class("bvh8:lbvh"), "fast");
+}
+
+TEST(BackendNames, ReinsertIsAnOptionOfBvh2AndTheWideBvhsInAnyOrder) {
+  std::vector<std::string> names;
+  for (const BackendInfo& b : list_backends()) names.push_back(b.name);
+  for (const char* n : {"bvh2:reinsert", "bvh8:reinsert", "bvh4:reinsert", "bvh2:sbvh", "bvh8:sbvh"})
+    EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
+  for (const char* n : {"bvh2:reinsert", "bvh2:watertight:sweep:reinsert", "bvh2:reinsert:watertight:robust",
+                        "bvh8:reinsert", "bvh8:reinsert:lbvh", "bvh8:watertight:reinsert:robust", "bvh4:sbvh:reinsert"})
+    EXPECT_EQ(make_backend(n)->name(), n);
+  // Like a builder, it changes the tree, not the accuracy class.
+  EXPECT_EQ(backend_accuracy_class("bvh2:reinsert:watertight:robust"), "watertight");
+  EXPECT_EQ(backend_accuracy_class("bvh2:reinsert:mt_seed"), "epsilon");
+  EXPECT_EQ(backend_accuracy_class("bvh8:watertight:reinsert:robust"), "watertight");
+  EXPECT_EQ(backend_accuracy_class("bvh8:reinsert"), "fast");
 }
 
 // Rays at proc:terrain_spheres_small (terrain over [-100, 100]^2, spheres on
@@ -246,9 +266,10 @@ TEST(Builders, EveryBuilderGivesTheSameHitsAsTheDefaultBuild) {
   const Scene scene = load_scene("proc:terrain_spheres_small");
   const std::vector<Ray> rays = terrain_rays(false), segments = terrain_rays(true);
   for (const auto& [base, others] : std::vector<std::pair<std::string, std::vector<std::string>>>{
-           {"bvh2", {"bvh2:binned", "bvh2:sweep", "bvh2:lbvh"}},
-           {"bvh2:watertight:robust", {"bvh2:watertight:robust:sweep", "bvh2:lbvh:watertight:robust"}},
-           {"bvh8", {"bvh8:sweep", "bvh8:lbvh", "bvh2:sweep"}}}) {
+           {"bvh2", {"bvh2:binned", "bvh2:sweep", "bvh2:lbvh", "bvh2:sbvh", "bvh2:reinsert", "bvh2:sbvh:reinsert"}},
+           {"bvh2:watertight:robust",
+            {"bvh2:watertight:robust:sweep", "bvh2:lbvh:watertight:robust", "bvh2:reinsert:sbvh:watertight:robust"}},
+           {"bvh8", {"bvh8:sweep", "bvh8:lbvh", "bvh2:sweep", "bvh8:sbvh", "bvh8:reinsert"}}}) {
     const auto reference = make_backend(base);
     reference->build(scene);
     std::vector<Hit> expected(rays.size());
@@ -291,7 +312,8 @@ TEST(Builders, OurBackendsReportTheSahCostOfTheirTreeAndEmbreeNone) {
     backend->build(scene);
     return backend->sah_cost();
   };
-  for (const char* name : {"bvh2", "bvh2:sweep", "bvh2:lbvh", "bvh8", "bvh8:sweep", "bvh8:lbvh"}) {
+  for (const char* name : {"bvh2", "bvh2:sweep", "bvh2:lbvh", "bvh2:sbvh", "bvh2:reinsert", "bvh8", "bvh8:sweep",
+                           "bvh8:lbvh", "bvh8:sbvh", "bvh8:reinsert"}) {
     EXPECT_TRUE(std::isfinite(cost(name))) << name;
     EXPECT_GT(cost(name), 1.0) << name;  // the root alone costs 1
   }
@@ -303,6 +325,11 @@ TEST(Builders, OurBackendsReportTheSahCostOfTheirTreeAndEmbreeNone) {
   EXPECT_GT(cost("bvh2:lbvh"), cost("bvh2"));
   EXPECT_LE(cost("bvh8:sweep"), cost("bvh8") * 1.005);
   EXPECT_GT(cost("bvh8:lbvh"), cost("bvh8"));
+  // Spatial splits and reinsertion only ever lower the BVH2's cost (the
+  // SBVH's greedy choices within 0.5 %, as the sweep's).
+  EXPECT_LE(cost("bvh2:sbvh"), cost("bvh2") * 1.005);
+  EXPECT_LE(cost("bvh2:reinsert"), cost("bvh2"));
+  EXPECT_LT(cost("bvh2:lbvh:reinsert"), cost("bvh2:lbvh"));
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 // touches, so a watertight triangle test stays watertight through the tree.
 // A builder option from raybench/bvh/bvh2_builders.h ("bvh2:sweep",
 // "bvh2:watertight:robust:lbvh") picks the builder; binned SAH by default.
+// "reinsert" optimises the built tree by reinsertion (bvh2_reinsertion.h).
 // Options come in any order, each kind at most once.
 #include <algorithm>
 #include <optional>
@@ -26,12 +27,13 @@ namespace {
 template <typename Test, typename BoxTest>
 class Bvh2Backend final : public Backend {
  public:
-  Bvh2Backend(std::string name, Bvh2Builder builder) : name_(std::move(name)), builder_(builder) {}
+  Bvh2Backend(std::string name, Bvh2Builder builder, const Bvh2BuildOptions& options)
+      : name_(std::move(name)), builder_(builder), options_(options) {}
 
   const std::string& name() const override { return name_; }
 
   void build(const Scene& scene) override {
-    bvh_ = build_bvh2(scene.triangles, builder_);
+    bvh_ = build_bvh2(scene.triangles, builder_, options_);
     prepared_.clear();
     prepared_.reserve(bvh_.prim_ids.size());
     for (std::uint32_t id : bvh_.prim_ids) prepared_.push_back(Test::prepare(scene.triangles[id]));
@@ -57,6 +59,7 @@ class Bvh2Backend final : public Backend {
  private:
   std::string name_;
   Bvh2Builder builder_;
+  Bvh2BuildOptions options_;
   Bvh2 bvh_;
   std::vector<typename Test::Prepared> prepared_;
 };
@@ -67,32 +70,36 @@ std::unique_ptr<Backend> make_bvh2_backend(const std::string& name, const std::v
                                            const BackendConfig&) {
   std::vector<std::string_view> tests;
   for_each_variant<TriangleTests>([&](auto test) { tests.push_back(decltype(test)::name); });
-  const std::string valid =
-      fmt::format("triangle tests: {}; builders: {}; traversal: robust", fmt::join(tests, ", "), bvh2_builder_names());
+  const std::string valid = fmt::format("triangle tests: {}; builders: {}; traversal: robust; tree: {}",
+                                        fmt::join(tests, ", "), bvh2_builder_names(), kReinsertOption);
   std::optional<std::string> test_name;
   std::optional<Bvh2Builder> builder;
-  bool robust = false;
+  bool robust = false, reinsert = false;
   for (const std::string& o : options) {
     const std::optional<Bvh2Builder> as_builder = parse_bvh2_builder(o);
     const bool is_test = std::find(tests.begin(), tests.end(), o) != tests.end();
-    if (o != "robust" && !as_builder && !is_test)
+    if (o != "robust" && o != kReinsertOption && !as_builder && !is_test)
       throw InputError("", fmt::format("backend '{}': unknown option '{}' ({})", name, o, valid));
-    if ((o == "robust" && robust) || (as_builder && builder) || (is_test && test_name))
-      throw InputError("", fmt::format("backend '{}': bvh2 takes a triangle test, a builder and 'robust', each at most "
-                                       "once, in any order, e.g. bvh2:watertight:robust:sweep ({})",
-                                       name, valid));
+    if ((o == "robust" && robust) || (o == kReinsertOption && reinsert) || (as_builder && builder) ||
+        (is_test && test_name))
+      throw InputError("", fmt::format("backend '{}': bvh2 takes a triangle test, a builder, 'robust' and '{}', each "
+                                       "at most once, in any order, e.g. bvh2:watertight:robust:sweep:{} ({})",
+                                       name, kReinsertOption, kReinsertOption, valid));
     if (o == "robust") robust = true;
+    else if (o == kReinsertOption) reinsert = true;
     else if (as_builder) builder = as_builder;
     else test_name = o;
   }
+  Bvh2BuildOptions build_options;
+  if (reinsert) build_options.reinsertion_passes = Bvh2ReinsertionOptions{}.passes;
   const std::string wanted = test_name.value_or(std::string(std::tuple_element_t<0, TriangleTests>::name));
   std::unique_ptr<Backend> made;
   for_each_variant<TriangleTests>([&](auto test) {
     using Test = decltype(test);
     if (Test::name != wanted) return;
     const Bvh2Builder b = builder.value_or(Bvh2Builder::kBinnedSah);
-    if (robust) made = std::make_unique<Bvh2Backend<Test, SlabRobust>>(name, b);
-    else made = std::make_unique<Bvh2Backend<Test, Slab>>(name, b);
+    if (robust) made = std::make_unique<Bvh2Backend<Test, SlabRobust>>(name, b, build_options);
+    else made = std::make_unique<Bvh2Backend<Test, Slab>>(name, b, build_options);
   });
   return made;
 }
@@ -113,6 +120,11 @@ std::vector<BackendInfo> bvh2_backend_names() {
                    fmt::format("bvh2 built by {}; any bvh2 name takes :<builder>", description(b)),
                    default_accuracy});
   }
+  out.push_back({fmt::format("bvh2:{}", kReinsertOption),
+                 fmt::format("bvh2 with its tree optimised by reinsertion (Bittner et al. 2013, in parallel batches); "
+                             "any bvh2 name takes :{}",
+                             kReinsertOption),
+                 default_accuracy});
   return out;
 }
 

@@ -6,7 +6,9 @@
 //     or, 8 wide only, watertight (Woop et al. 2013, simd/triangle8_watertight.h);
 //   robust: the conservative wide box test (Ize's padding), so that
 //     bvh8:watertight:robust leaks no ray through the tree either;
-//   a builder from raybench/bvh/bvh2_builders.h ("bvh8:sweep", "bvh4:lbvh").
+//   a builder from raybench/bvh/bvh2_builders.h ("bvh8:sweep", "bvh4:lbvh");
+//   reinsert: the BVH2 optimised by reinsertion before the collapse
+//     (bvh2_reinsertion.h).
 #include <optional>
 
 #include <fmt/format.h>
@@ -22,7 +24,8 @@ namespace {
 template <int W, typename Leaf, typename BoxTest>
 class WideBvhBackend final : public Backend {
  public:
-  WideBvhBackend(std::string name, Bvh2Builder builder) : name_(std::move(name)), builder_(builder) {}
+  WideBvhBackend(std::string name, Bvh2Builder builder, int reinsertion_passes)
+      : name_(std::move(name)), builder_(builder), reinsertion_passes_(reinsertion_passes) {}
 
   const std::string& name() const override { return name_; }
 
@@ -30,6 +33,7 @@ class WideBvhBackend final : public Backend {
     Bvh2BuildOptions options;
     options.leaf_granularity = W;  // leaves are tested W triangles at once
     options.max_leaf_size = W;     // and hold at most one pack
+    options.reinsertion_passes = reinsertion_passes_;
     bvh_ = collapse_bvh2<W>(build_bvh2(scene.triangles, builder_, options), scene.triangles, Leaf::kLeaves);
   }
 
@@ -52,43 +56,49 @@ class WideBvhBackend final : public Backend {
  private:
   std::string name_;
   Bvh2Builder builder_;
+  int reinsertion_passes_;
   WideBvh<W> bvh_;
 };
 
 template <int W, typename Leaf>
-std::unique_ptr<Backend> make_with_box_test(const std::string& name, Bvh2Builder builder, bool robust) {
-  if (robust) return std::make_unique<WideBvhBackend<W, Leaf, SlabRobust>>(name, builder);
-  return std::make_unique<WideBvhBackend<W, Leaf, Slab>>(name, builder);
+std::unique_ptr<Backend> make_with_box_test(const std::string& name, Bvh2Builder builder, int reinsertion_passes,
+                                            bool robust) {
+  if (robust) return std::make_unique<WideBvhBackend<W, Leaf, SlabRobust>>(name, builder, reinsertion_passes);
+  return std::make_unique<WideBvhBackend<W, Leaf, Slab>>(name, builder, reinsertion_passes);
 }
 
 template <int W>
 std::unique_ptr<Backend> make_wide_backend(const std::string& name, const std::vector<std::string>& options) {
   const std::string family = fmt::format("bvh{}", W);
   const std::string tests = W == 8 ? "mt, watertight" : "mt";
-  const std::string valid = fmt::format("triangle tests: {}; robust; builders: {}", tests, bvh2_builder_names());
+  const std::string valid =
+      fmt::format("triangle tests: {}; robust; builders: {}; {}", tests, bvh2_builder_names(), kReinsertOption);
   std::optional<std::string> test;
   std::optional<Bvh2Builder> builder;
-  bool robust = false;
+  bool robust = false, reinsert = false;
   for (const std::string& o : options) {
     const std::optional<Bvh2Builder> as_builder = parse_bvh2_builder(o);
     const bool is_test = o == "mt" || o == "watertight";
     if (W != 8 && o == "watertight")
       throw InputError("", fmt::format("backend '{}': watertight leaves are 8 wide only; use bvh8:watertight", name));
-    if (!is_test && !as_builder && o != "robust")
+    if (!is_test && !as_builder && o != "robust" && o != kReinsertOption)
       throw InputError("", fmt::format("backend '{}': unknown option '{}' ({})", name, o, valid));
-    if ((is_test && test) || (as_builder && builder) || (o == "robust" && robust))
-      throw InputError("", fmt::format("backend '{}': {} takes a triangle test, 'robust' and a builder, each at most "
-                                       "once, in any order, e.g. {}:{}robust:sweep ({})",
-                                       name, family, family, W == 8 ? "watertight:" : "", valid));
+    if ((is_test && test) || (as_builder && builder) || (o == "robust" && robust) || (o == kReinsertOption && reinsert))
+      throw InputError("", fmt::format("backend '{}': {} takes a triangle test, 'robust', a builder and '{}', each at "
+                                       "most once, in any order, e.g. {}:{}robust:sweep:{} ({})",
+                                       name, family, kReinsertOption, family, W == 8 ? "watertight:" : "",
+                                       kReinsertOption, valid));
     if (as_builder) builder = as_builder;
     else if (is_test) test = o;
+    else if (o == kReinsertOption) reinsert = true;
     else robust = true;
   }
   const Bvh2Builder b = builder.value_or(Bvh2Builder::kBinnedSah);
+  const int passes = reinsert ? Bvh2ReinsertionOptions{}.passes : 0;
   if constexpr (W == 8) {
-    if (test.value_or("mt") == "watertight") return make_with_box_test<8, Bvh8Watertight>(name, b, robust);
+    if (test.value_or("mt") == "watertight") return make_with_box_test<8, Bvh8Watertight>(name, b, passes, robust);
   }
-  return make_with_box_test<W, WideMollerTrumbore>(name, b, robust);
+  return make_with_box_test<W, WideMollerTrumbore>(name, b, passes, robust);
 }
 
 template <int W>
@@ -102,6 +112,10 @@ std::vector<BackendInfo> wide_backend_names() {
     out.push_back({family + ":" + std::string(to_string(b)),
                    fmt::format("{} from a BVH2 built by {}; any {} name takes :<builder>", family, description(b), family)});
   }
+  out.push_back({fmt::format("{}:{}", family, kReinsertOption),
+                 fmt::format("{} from a BVH2 optimised by reinsertion (Bittner et al. 2013, in parallel batches); any "
+                             "{} name takes :{}",
+                             family, family, kReinsertOption)});
   if constexpr (W == 8) {
     out.push_back(
         {"bvh8:watertight", "bvh8 with 8-wide watertight leaves (Woop, Benthin & Wald 2013) [watertight]", "watertight"});

@@ -52,6 +52,9 @@ struct Bvh2BuildOptions {
   // SBVH only: spatial splits add at most this fraction of the triangle
   // count in extra references (0.5: prim_ids holds at most 1.5 n entries).
   float spatial_split_budget = 0.5f;
+  // Passes of reinsertion optimisation after the build (bvh2_reinsertion.h),
+  // made by build_bvh2 (bvh2_builders.h) for any builder; 0: none.
+  int reinsertion_passes = 0;
 };
 
 // Every builder places each triangle in at least one leaf, degenerate ones

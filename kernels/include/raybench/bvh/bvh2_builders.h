@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "raybench/bvh/bvh2.h"
+#include "raybench/bvh/bvh2_reinsertion.h"
 
 namespace raybench {
 
@@ -64,6 +65,17 @@ constexpr std::optional<Bvh2Builder> parse_bvh2_builder(std::string_view name) {
   return std::nullopt;
 }
 
+// The backend option that optimises the built tree by reinsertion
+// ("bvh2:reinsert", "bvh8:sweep:reinsert"): Bvh2BuildOptions::reinsertion_passes
+// = Bvh2ReinsertionOptions{}.passes.
+inline constexpr std::string_view kReinsertOption = "reinsert";
+
+// Whether a backend option changes only the tree (a builder, or reinsertion),
+// not what a ray hits: the accuracy class looks through it.
+constexpr bool is_bvh2_tree_option(std::string_view option) {
+  return option == kReinsertOption || parse_bvh2_builder(option).has_value();
+}
+
 // "binned, sweep, lbvh, sbvh": for help texts and error messages.
 inline std::string bvh2_builder_names() {
   std::string out;
@@ -71,14 +83,21 @@ inline std::string bvh2_builder_names() {
   return out;
 }
 
+// The tree of `builder`, then options.reinsertion_passes passes of
+// reinsertion optimisation (bvh2_reinsertion.h), within the same depth bound.
 inline Bvh2 build_bvh2(std::span<const Triangle> triangles, Bvh2Builder builder, const Bvh2BuildOptions& options = {}) {
-  switch (builder) {
-    case Bvh2Builder::kSweepSah: return build_bvh2_sweep_sah(triangles, options);
-    case Bvh2Builder::kLbvh: return build_bvh2_lbvh(triangles, options);
-    case Bvh2Builder::kSbvh: return build_bvh2_sbvh(triangles, options);
-    case Bvh2Builder::kBinnedSah: break;
-  }
-  return build_bvh2_binned_sah(triangles, options);
+  Bvh2 bvh = [&] {
+    switch (builder) {
+      case Bvh2Builder::kSweepSah: return build_bvh2_sweep_sah(triangles, options);
+      case Bvh2Builder::kLbvh: return build_bvh2_lbvh(triangles, options);
+      case Bvh2Builder::kSbvh: return build_bvh2_sbvh(triangles, options);
+      case Bvh2Builder::kBinnedSah: break;
+    }
+    return build_bvh2_binned_sah(triangles, options);
+  }();
+  if (options.reinsertion_passes > 0)
+    optimize_bvh2_reinsertion(bvh, {.passes = options.reinsertion_passes, .max_depth = options.max_sah_depth + 32});
+  return bvh;
 }
 
 }  // namespace raybench
