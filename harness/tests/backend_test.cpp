@@ -198,6 +198,8 @@ TEST(BackendNames, UnknownFamiliesAndOptionsAreErrorsThatSaySo) {
   EXPECT_NE(error_of("bvh8:lbvh:sweep").find("each at most once"), std::string::npos);
   EXPECT_NE(error_of("bvh2:reinsert:sweep:reinsert").find("each at most once"), std::string::npos);
   EXPECT_NE(error_of("bvh8:reinsert:reinsert").find("each at most once"), std::string::npos);
+  EXPECT_NE(error_of("bvh4:mt:mt").find("bvh4 takes a triangle test"), std::string::npos);
+  EXPECT_NE(error_of("bvh4:watertight").find("watertight leaves are 8 wide only"), std::string::npos);
   // The messages list what is valid.
   for (const char* bad : {"bvh2:magic", "bvh2:sweep:lbvh", "bvh8:magic", "bvh8:mt:mt"})
     EXPECT_NE(error_of(bad).find("builders: binned, sweep, lbvh"), std::string::npos) << bad;

@@ -15,6 +15,7 @@
 #include <fmt/ranges.h>
 
 #include "backends/backend_families.h"
+#include "backends/bvh_options.h"
 #include "error.h"
 #include "raybench/bvh/bvh2_builders.h"
 #include "raybench/bvh/bvh2_traverse.h"
@@ -70,35 +71,16 @@ std::unique_ptr<Backend> make_bvh2_backend(const std::string& name, const std::v
                                            const BackendConfig&) {
   std::vector<std::string_view> tests;
   for_each_variant<TriangleTests>([&](auto test) { tests.push_back(decltype(test)::name); });
-  const std::string valid = fmt::format("triangle tests: {}; builders: {}; traversal: robust; tree: {}",
-                                        fmt::join(tests, ", "), bvh2_builder_names(), kReinsertOption);
-  std::optional<std::string> test_name;
-  std::optional<Bvh2Builder> builder;
-  bool robust = false, reinsert = false;
-  for (const std::string& o : options) {
-    const std::optional<Bvh2Builder> as_builder = parse_bvh2_builder(o);
-    const bool is_test = std::find(tests.begin(), tests.end(), o) != tests.end();
-    if (o != "robust" && o != kReinsertOption && !as_builder && !is_test)
-      throw InputError("", fmt::format("backend '{}': unknown option '{}' ({})", name, o, valid));
-    if ((o == "robust" && robust) || (o == kReinsertOption && reinsert) || (as_builder && builder) ||
-        (is_test && test_name))
-      throw InputError("", fmt::format("backend '{}': bvh2 takes a triangle test, a builder, 'robust' and '{}', each "
-                                       "at most once, in any order, e.g. bvh2:watertight:robust:sweep:{} ({})",
-                                       name, kReinsertOption, kReinsertOption, valid));
-    if (o == "robust") robust = true;
-    else if (o == kReinsertOption) reinsert = true;
-    else if (as_builder) builder = as_builder;
-    else test_name = o;
-  }
+  const BvhOptions parsed = parse_bvh_options(name, "bvh2", options, tests, "bvh2:watertight:robust:sweep:reinsert");
   Bvh2BuildOptions build_options;
-  if (reinsert) build_options.reinsertion_passes = Bvh2ReinsertionOptions{}.passes;
-  const std::string wanted = test_name.value_or(std::string(std::tuple_element_t<0, TriangleTests>::name));
+  build_options.reinsertion_passes = parsed.reinsertion_passes();
+  const std::string wanted = parsed.test.value_or(std::string(std::tuple_element_t<0, TriangleTests>::name));
   std::unique_ptr<Backend> made;
   for_each_variant<TriangleTests>([&](auto test) {
     using Test = decltype(test);
     if (Test::name != wanted) return;
-    const Bvh2Builder b = builder.value_or(Bvh2Builder::kBinnedSah);
-    if (robust) made = std::make_unique<Bvh2Backend<Test, SlabRobust>>(name, b, build_options);
+    const Bvh2Builder b = parsed.builder_or_default();
+    if (parsed.robust) made = std::make_unique<Bvh2Backend<Test, SlabRobust>>(name, b, build_options);
     else made = std::make_unique<Bvh2Backend<Test, Slab>>(name, b, build_options);
   });
   return made;

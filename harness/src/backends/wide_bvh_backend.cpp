@@ -9,11 +9,13 @@
 //   a builder from raybench/bvh/bvh2_builders.h ("bvh8:sweep", "bvh4:lbvh");
 //   reinsert: the BVH2 optimised by reinsertion before the collapse
 //     (bvh2_reinsertion.h).
-#include <optional>
+#include <algorithm>
+#include <span>
 
 #include <fmt/format.h>
 
 #include "backends/backend_families.h"
+#include "backends/bvh_options.h"
 #include "error.h"
 #include "raybench/bvh/bvh2_builders.h"
 #include "raybench/bvh/wide_bvh_traverse.h"
@@ -69,36 +71,20 @@ std::unique_ptr<Backend> make_with_box_test(const std::string& name, Bvh2Builder
 
 template <int W>
 std::unique_ptr<Backend> make_wide_backend(const std::string& name, const std::vector<std::string>& options) {
+  // Watertight leaves are 8 wide only: say so rather than "unknown option".
+  if (W != 8 && std::find(options.begin(), options.end(), "watertight") != options.end())
+    throw InputError("", fmt::format("backend '{}': watertight leaves are 8 wide only; use bvh8:watertight", name));
+  static constexpr std::string_view kTests8[] = {"mt", "watertight"}, kTests4[] = {"mt"};
   const std::string family = fmt::format("bvh{}", W);
-  const std::string tests = W == 8 ? "mt, watertight" : "mt";
-  const std::string valid =
-      fmt::format("triangle tests: {}; robust; builders: {}; {}", tests, bvh2_builder_names(), kReinsertOption);
-  std::optional<std::string> test;
-  std::optional<Bvh2Builder> builder;
-  bool robust = false, reinsert = false;
-  for (const std::string& o : options) {
-    const std::optional<Bvh2Builder> as_builder = parse_bvh2_builder(o);
-    const bool is_test = o == "mt" || o == "watertight";
-    if (W != 8 && o == "watertight")
-      throw InputError("", fmt::format("backend '{}': watertight leaves are 8 wide only; use bvh8:watertight", name));
-    if (!is_test && !as_builder && o != "robust" && o != kReinsertOption)
-      throw InputError("", fmt::format("backend '{}': unknown option '{}' ({})", name, o, valid));
-    if ((is_test && test) || (as_builder && builder) || (o == "robust" && robust) || (o == kReinsertOption && reinsert))
-      throw InputError("", fmt::format("backend '{}': {} takes a triangle test, 'robust', a builder and '{}', each at "
-                                       "most once, in any order, e.g. {}:{}robust:sweep:{} ({})",
-                                       name, family, kReinsertOption, family, W == 8 ? "watertight:" : "",
-                                       kReinsertOption, valid));
-    if (as_builder) builder = as_builder;
-    else if (is_test) test = o;
-    else if (o == kReinsertOption) reinsert = true;
-    else robust = true;
-  }
-  const Bvh2Builder b = builder.value_or(Bvh2Builder::kBinnedSah);
-  const int passes = reinsert ? Bvh2ReinsertionOptions{}.passes : 0;
+  const BvhOptions parsed = parse_bvh_options(
+      name, family, options, W == 8 ? std::span<const std::string_view>(kTests8) : std::span<const std::string_view>(kTests4),
+      family + (W == 8 ? ":watertight:robust:sweep:reinsert" : ":robust:sweep:reinsert"));
+  const Bvh2Builder b = parsed.builder_or_default();
+  const int passes = parsed.reinsertion_passes();
   if constexpr (W == 8) {
-    if (test.value_or("mt") == "watertight") return make_with_box_test<8, Bvh8Watertight>(name, b, passes, robust);
+    if (parsed.test.value_or("mt") == "watertight") return make_with_box_test<8, Bvh8Watertight>(name, b, passes, parsed.robust);
   }
-  return make_with_box_test<W, WideMollerTrumbore>(name, b, passes, robust);
+  return make_with_box_test<W, WideMollerTrumbore>(name, b, passes, parsed.robust);
 }
 
 template <int W>

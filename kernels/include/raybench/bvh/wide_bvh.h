@@ -86,7 +86,6 @@ struct WideBvh {
 };
 using Bvh8 = WideBvh<8>;
 using Bvh4 = WideBvh<4>;
-using Bvh8Node = WideNode<8>;
 
 // Collapses `bvh2` (whose leaves hold at most W triangles, as every builder
 // of bvh2_builders.h makes them with max_leaf_size W) over `triangles`.
