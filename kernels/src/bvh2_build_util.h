@@ -98,14 +98,18 @@ void sweep_bins(const std::array<BBox, MaxBins>& boxes, const std::array<std::si
 }
 
 // Bins `refs` on all three axes in one pass: bin_bounds[axis][b] and
-// bin_count[axis][b] for b < bins. The build's hottest loop: each reference
-// is read once, its box extends the bins as two SSE min/max (the same
-// comparisons as BBox::extend, so NaN boxes bin as before), and even and odd
-// references fill separate bins, merged at the end, so that a run of
-// references in one bin does not wait on its own stores.
-template <std::size_t MaxBins, typename Ref, typename CentroidOf>
+// bin_count[axis][b] for b < bins, a reference binned by its box's centre
+// (BBox::center, the centroid every builder splits by). The build's hottest
+// loop: each reference is read once, its centre and its three bins are
+// computed as one SSE vector (the same operations as BBox::center and
+// centroid_bin, so every reference lands in the bin the partition puts it
+// in), its box extends the bins as two SSE min/max (the same comparisons as
+// BBox::extend, so NaN boxes bin as before), and even and odd references
+// fill separate bins, merged at the end, so that a run of references in one
+// bin does not wait on its own stores.
+template <std::size_t MaxBins, typename Ref>
 void bin_all_axes(std::span<const Ref> refs, const float lo[3], const float scale[3], int bins,
-                  CentroidOf&& centroid_of, std::array<std::array<BBox, MaxBins>, 3>& bin_bounds,
+                  std::array<std::array<BBox, MaxBins>, 3>& bin_bounds,
                   std::array<std::array<std::size_t, MaxBins>, 3>& bin_count) {
 #if defined(__SSE2__)
   alignas(16) __m128 lower[2][3][MaxBins], upper[2][3][MaxBins];
@@ -121,17 +125,23 @@ void bin_all_axes(std::span<const Ref> refs, const float lo[3], const float scal
   const auto load3 = [](const Vec3f& v) {
     return _mm_movelh_ps(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(&v.x))), _mm_load_ss(&v.z));
   };
+  const __m128 lo4 = _mm_setr_ps(lo[0], lo[1], lo[2], 0.0f), scale4 = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
+  const __m128 half = _mm_set1_ps(0.5f), zero = _mm_setzero_ps(), last_bin = _mm_set1_ps(static_cast<float>(bins - 1));
   for (std::size_t i = 0; i < refs.size(); ++i) {
     const Ref& r = refs[i];
     const int set = static_cast<int>(i & 1u);
     const __m128 ref_lower = load3(r.bounds.lower), ref_upper = load3(r.bounds.upper);
-    const auto c = centroid_of(r);
+    // centroid_bin on three axes: max_ps(f, 0) is 0 for a NaN f, as below lo;
+    // min with bins - 1 before truncation gives the last bin from bins - 1 on.
+    const __m128 centre = _mm_mul_ps(_mm_add_ps(ref_lower, ref_upper), half);
+    const __m128 f = _mm_mul_ps(_mm_sub_ps(centre, lo4), scale4);
+    alignas(16) std::int32_t b[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(b), _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(f, zero), last_bin)));
     for (int axis = 0; axis < 3; ++axis) {
-      const int b = centroid_bin(c[axis], lo[axis], scale[axis], bins);
       // min_ps(x, y) is (x < y ? x : y), as std::min(y, x): BBox::extend's order.
-      lower[set][axis][b] = _mm_min_ps(ref_lower, lower[set][axis][b]);
-      upper[set][axis][b] = _mm_max_ps(ref_upper, upper[set][axis][b]);
-      ++count[set][axis][b];
+      lower[set][axis][b[axis]] = _mm_min_ps(ref_lower, lower[set][axis][b[axis]]);
+      upper[set][axis][b[axis]] = _mm_max_ps(ref_upper, upper[set][axis][b[axis]]);
+      ++count[set][axis][b[axis]];
     }
   }
   for (int axis = 0; axis < 3; ++axis)
@@ -148,7 +158,7 @@ void bin_all_axes(std::span<const Ref> refs, const float lo[3], const float scal
     }
 #else
   for (const Ref& r : refs) {
-    const auto c = centroid_of(r);
+    const Vec3f c = r.bounds.center();
     for (int axis = 0; axis < 3; ++axis) {
       const int b = centroid_bin(c[axis], lo[axis], scale[axis], bins);
       bin_bounds[axis][b].extend(r.bounds);
@@ -158,9 +168,8 @@ void bin_all_axes(std::span<const Ref> refs, const float lo[3], const float scal
 #endif
 }
 
-template <std::size_t MaxBins, typename Ref, typename CentroidOf>
-ObjectSplit find_object_split_in(std::span<const Ref> refs, const BBox& centroid_bounds, int bins, int granularity,
-                                 CentroidOf&& centroid_of) {
+template <std::size_t MaxBins, typename Ref>
+ObjectSplit find_object_split_in(std::span<const Ref> refs, const BBox& centroid_bounds, int bins, int granularity) {
   float lo[3], scale[3];
   bool splittable[3];
   for (int axis = 0; axis < 3; ++axis) {
@@ -171,7 +180,7 @@ ObjectSplit find_object_split_in(std::span<const Ref> refs, const BBox& centroid
   }
   std::array<std::array<BBox, MaxBins>, 3> bin_bounds{};
   std::array<std::array<std::size_t, MaxBins>, 3> bin_count{};
-  bin_all_axes<MaxBins>(refs, lo, scale, bins, centroid_of, bin_bounds, bin_count);
+  bin_all_axes<MaxBins>(refs, lo, scale, bins, bin_bounds, bin_count);
   ObjectSplit best;
   for (int axis = 0; axis < 3; ++axis) {
     if (!splittable[axis]) continue;
@@ -183,17 +192,16 @@ ObjectSplit find_object_split_in(std::span<const Ref> refs, const BBox& centroid
   return best;
 }
 
-// The cheapest object split of `refs` (anything with a `bounds` box; the
-// centroid is centroid_of(ref)), counting leaf tests in packs of
-// `granularity`; both sides non-empty. The bin arrays are sized for the
-// bins asked for (16 by default), not kMaxBins: setting up 64 bins per node
-// cost more than binning the few triangles of the deep nodes.
-template <typename Ref, typename CentroidOf>
-ObjectSplit find_object_split(std::span<const Ref> refs, const BBox& centroid_bounds, int bins, int granularity,
-                              CentroidOf&& centroid_of) {
-  if (bins <= 16) return find_object_split_in<16>(refs, centroid_bounds, bins, granularity, centroid_of);
-  if (bins <= 32) return find_object_split_in<32>(refs, centroid_bounds, bins, granularity, centroid_of);
-  return find_object_split_in<kMaxBins>(refs, centroid_bounds, bins, granularity, centroid_of);
+// The cheapest object split of `refs` (anything with a `bounds` box, split by
+// its centre), counting leaf tests in packs of `granularity`; both sides
+// non-empty. The bin arrays are sized for the bins asked for (16 by
+// default), not kMaxBins: setting up 64 bins per node cost more than binning
+// the few triangles of the deep nodes.
+template <typename Ref>
+ObjectSplit find_object_split(std::span<const Ref> refs, const BBox& centroid_bounds, int bins, int granularity) {
+  if (bins <= 16) return find_object_split_in<16>(refs, centroid_bounds, bins, granularity);
+  if (bins <= 32) return find_object_split_in<32>(refs, centroid_bounds, bins, granularity);
+  return find_object_split_in<kMaxBins>(refs, centroid_bounds, bins, granularity);
 }
 
 // Builds both children of a split: as two TBB tasks when the range is large

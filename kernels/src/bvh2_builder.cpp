@@ -7,81 +7,166 @@
 #include <array>
 #include <atomic>
 #include <limits>
+#include <memory>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 
 #include "raybench/bvh/bvh2.h"
+#include "build_buffer.h"
 #include "bvh2_build_util.h"
 
 namespace raybench {
 namespace {
 
+// 28 bytes: the centroid is the box's centre, computed where needed rather
+// than stored (the build is bound by reading references).
 struct PrimRef {
   BBox bounds;
-  Vec3f centroid;
-  std::uint32_t id;
+  std::uint32_t id;  // also read (and ignored) as the fourth lane of bounds.upper
 };
 
+using bvh2_build::BuildBuffer;
 using bvh2_build::centroid_bin;
 using bvh2_build::kMaxBins;
 using bvh2_build::ObjectSplit;
 
+// The box and the centroid box of a range of references, gathered in SSE
+// registers (the same min/max and centre as BBox::extend and BBox::center).
+struct RangeBounds {
+#if defined(__SSE2__)
+  __m128 lower = _mm_set1_ps(std::numeric_limits<float>::infinity()), upper = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+  __m128 centroid_lower = lower, centroid_upper = upper;
+
+  void extend(const PrimRef& r) {
+    const __m128 l = _mm_loadu_ps(&r.bounds.lower.x), u = _mm_loadu_ps(&r.bounds.upper.x);  // lane 3 unused
+    const __m128 c = _mm_mul_ps(_mm_add_ps(l, u), _mm_set1_ps(0.5f));
+    lower = _mm_min_ps(l, lower);
+    upper = _mm_max_ps(u, upper);
+    centroid_lower = _mm_min_ps(c, centroid_lower);
+    centroid_upper = _mm_max_ps(c, centroid_upper);
+  }
+  void extend(const RangeBounds& b) {
+    lower = _mm_min_ps(b.lower, lower);
+    upper = _mm_max_ps(b.upper, upper);
+    centroid_lower = _mm_min_ps(b.centroid_lower, centroid_lower);
+    centroid_upper = _mm_max_ps(b.centroid_upper, centroid_upper);
+  }
+  static BBox box(__m128 l, __m128 u) {
+    alignas(16) float lf[4], uf[4];
+    _mm_store_ps(lf, l);
+    _mm_store_ps(uf, u);
+    return BBox{{lf[0], lf[1], lf[2]}, {uf[0], uf[1], uf[2]}};
+  }
+  BBox bounds() const { return box(lower, upper); }
+  BBox centroids() const { return box(centroid_lower, centroid_upper); }
+#else
+  BBox box, centroid_box;
+  void extend(const PrimRef& r) {
+    box.extend(r.bounds);
+    centroid_box.extend(r.bounds.center());
+  }
+  void extend(const RangeBounds& b) {
+    box.extend(b.box);
+    centroid_box.extend(b.centroid_box);
+  }
+  BBox bounds() const { return box; }
+  BBox centroids() const { return centroid_box; }
+#endif
+};
+
+RangeBounds range_bounds(const PrimRef* first, const PrimRef* last) {
+  RangeBounds b;
+  for (; first != last; ++first) b.extend(*first);
+  return b;
+}
+
 class Builder {
  public:
-  Builder(std::vector<PrimRef>& refs, std::vector<Bvh2Node>& nodes, const Bvh2BuildOptions& options)
+  Builder(BuildBuffer<PrimRef>& refs, BuildBuffer<Bvh2Node>& nodes, const Bvh2BuildOptions& options)
       : refs_(refs), nodes_(nodes), options_(options), bins_(std::clamp(options.bin_count, 2, kMaxBins)) {}
 
-  // Builds the subtree for refs_[begin, end) into nodes_[node_index].
-  void build(std::uint32_t node_index, std::size_t begin, std::size_t end, int depth) {
-    BBox bounds, centroid_bounds;
-    for (std::size_t i = begin; i < end; ++i) {
-      bounds.extend(refs_[i].bounds);
-      centroid_bounds.extend(refs_[i].centroid);
-    }
-    Bvh2Node& node = nodes_[node_index];
-    node.bounds = bounds;
+  // Builds the subtree for refs_[begin, end), whose boxes are `range`, into
+  // nodes_[node_index]. The children's boxes come out of the partition, so
+  // no node reads its references more than twice (to bin, to partition).
+  void build(std::uint32_t node_index, std::size_t begin, std::size_t end, const RangeBounds& range, int depth) {
+    Bvh2Node& node = *std::construct_at(&nodes_[node_index], Bvh2Node{range.bounds()});
+    const BBox centroids = range.centroids();
     const std::size_t count = end - begin;
     const auto make_leaf = [&] {
       node.first_index = static_cast<std::uint32_t>(begin);
       node.prim_count = static_cast<std::uint32_t>(count);
     };
     if (count <= 1) return make_leaf();
+    const float leaf_cost = bvh2_build::leaf_tests(count, options_.leaf_granularity);
+    // A split costs at least the traversal step: no need to bin a range
+    // whose leaf costs no more (every range of at most 8 with 8-wide leaves).
+    if (count <= static_cast<std::size_t>(options_.max_leaf_size) && leaf_cost <= options_.traversal_cost)
+      return make_leaf();
 
     const ObjectSplit split = depth < options_.max_sah_depth
                                   ? bvh2_build::find_object_split(std::span<const PrimRef>(refs_.data() + begin, count),
-                                                                  centroid_bounds, bins_for(count), options_.leaf_granularity,
-                                                                  [](const PrimRef& r) { return r.centroid; })
+                                                                  centroids, bins_for(count), options_.leaf_granularity)
                                   : ObjectSplit{};
-    const float leaf_cost = bvh2_build::leaf_tests(count, options_.leaf_granularity);
-    std::size_t middle;
-    if (split.axis < 0) {
+    PrimRef* const first = refs_.data() + begin;
+    PrimRef* const last = refs_.data() + end;
+    PrimRef* middle = nullptr;
+    RangeBounds left, right;
+    if (split.axis >= 0) {
+      const float split_cost = options_.traversal_cost + split.cost / node.bounds.half_area();
+      if (split_cost >= leaf_cost && count <= static_cast<std::size_t>(options_.max_leaf_size)) return make_leaf();
+      middle = partition(first, last, centroids, split, bins_for(count), left, right);
+      if (middle == first || middle == last) middle = nullptr;  // float rounding put all on one side
+    } else if (count <= static_cast<std::size_t>(options_.max_leaf_size)) {
+      return make_leaf();
+    }
+    if (middle == nullptr) {
       // All centroids coincide (e.g. duplicated or degenerate triangles), or the
       // tree is already max_sah_depth deep: halve the range.
-      if (count <= static_cast<std::size_t>(options_.max_leaf_size)) return make_leaf();
-      middle = begin + count / 2;
-    } else {
-      const float split_cost = options_.traversal_cost + split.cost / bounds.half_area();
-      if (split_cost >= leaf_cost && count <= static_cast<std::size_t>(options_.max_leaf_size)) return make_leaf();
-      const int axis = split.axis;
-      const float lo = centroid_bounds.lower[axis];
-      const int bins = bins_for(count);
-      const float scale = bins / (centroid_bounds.upper[axis] - lo);
-      auto* mid = std::partition(refs_.data() + begin, refs_.data() + end, [&](const PrimRef& r) {
-        return centroid_bin(r.centroid[axis], lo, scale, bins) <= split.bin;
-      });
-      middle = static_cast<std::size_t>(mid - refs_.data());
-      if (middle == begin || middle == end) middle = begin + count / 2;  // float rounding put all on one side
+      middle = first + count / 2;
+      left = range_bounds(first, middle);
+      right = range_bounds(middle, last);
     }
 
-    const std::uint32_t left = next_node_.fetch_add(2);
-    node.first_index = left;
+    const auto mid = static_cast<std::size_t>(middle - refs_.data());
+    const std::uint32_t left_node = next_node_.fetch_add(2);
+    node.first_index = left_node;
     node.prim_count = 0;
-    bvh2_build::build_children(count, options_.parallel_threshold, [&] { build(left, begin, middle, depth + 1); },
-                               [&] { build(left + 1, middle, end, depth + 1); });
+    bvh2_build::build_children(
+        count, options_.parallel_threshold, [&] { build(left_node, begin, mid, left, depth + 1); },
+        [&] { build(left_node + 1, mid, end, right, depth + 1); });
   }
 
   std::uint32_t node_count() const { return next_node_.load(); }
 
  private:
+  // Moves the references whose centroid bin (the bins find_object_split used)
+  // is at most split.bin before the others, as std::partition, and returns
+  // the first of the others; gathers both sides' boxes on the way.
+  static PrimRef* partition(PrimRef* first, PrimRef* last, const BBox& centroids, const ObjectSplit& split, int bins,
+                            RangeBounds& left, RangeBounds& right) {
+    const int axis = split.axis;
+    const float lo = centroids.lower[axis];
+    const float scale = static_cast<float>(bins) / (centroids.upper[axis] - lo);
+    const auto goes_left = [&](const PrimRef& r) {
+      return centroid_bin(r.bounds.center()[axis], lo, scale, bins) <= split.bin;
+    };
+    for (;;) {
+      while (first != last && goes_left(*first)) left.extend(*first++);
+      while (first != last && !goes_left(*(last - 1))) right.extend(*--last);
+      if (first == last) return first;
+      std::swap(*first, *--last);
+      left.extend(*first++);
+      right.extend(*last);
+    }
+  }
+
   // Fewer bins for small ranges, where evaluating 16 bins costs more than
   // binning the few triangles: one bin per two triangles, at least 8
   // (Bvh2BuildOptions::bin_count at most). Measured on Sponza: the build 9 %
@@ -90,8 +175,8 @@ class Builder {
     return std::min(bins_, std::max(8, static_cast<int>(std::min<std::size_t>(count / 2, kMaxBins))));
   }
 
-  std::vector<PrimRef>& refs_;
-  std::vector<Bvh2Node>& nodes_;
+  BuildBuffer<PrimRef>& refs_;
+  BuildBuffer<Bvh2Node>& nodes_;
   const Bvh2BuildOptions& options_;
   const int bins_;
   std::atomic<std::uint32_t> next_node_{1};
@@ -99,27 +184,35 @@ class Builder {
 
 }  // namespace
 
+// References per task in the passes over all of them.
+constexpr std::size_t kGrain = 16384;
+
 Bvh2 build_bvh2_binned_sah(std::span<const Triangle> triangles, const Bvh2BuildOptions& options) {
   Bvh2 bvh;
-  std::vector<PrimRef> refs(triangles.size());
-  for (std::size_t i = 0; i < triangles.size(); ++i) {
-    BBox b;
-    b.extend(triangles[i].v0);
-    b.extend(triangles[i].v1);
-    b.extend(triangles[i].v2);
-    refs[i] = {b, b.center(), static_cast<std::uint32_t>(i)};
-  }
-  bvh.nodes.resize(std::max<std::size_t>(1, 2 * triangles.size()));
   if (triangles.empty()) {
     bvh.nodes.resize(1);  // an empty leaf whose empty box no ray enters
     return bvh;
   }
-  Builder builder(refs, bvh.nodes, options);
-  builder.build(0, 0, refs.size(), 0);
-  bvh.nodes.resize(builder.node_count());
-  bvh.nodes.shrink_to_fit();
+  BuildBuffer<PrimRef> refs(triangles.size());
+  const RangeBounds all = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, triangles.size(), kGrain), RangeBounds{},
+      [&](const tbb::blocked_range<std::size_t>& r, RangeBounds b) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+          b.extend(*std::construct_at(&refs[i], PrimRef{bvh2_build::triangle_bounds(triangles[i]), static_cast<std::uint32_t>(i)}));
+        return b;
+      },
+      [](RangeBounds a, const RangeBounds& b) {
+        a.extend(b);
+        return a;
+      });
+  BuildBuffer<Bvh2Node> nodes(2 * triangles.size() - 1);  // at most: every leaf one triangle
+  Builder builder(refs, nodes, options);
+  builder.build(0, 0, refs.size(), all, 0);
+  bvh.nodes.assign(nodes.data(), nodes.data() + builder.node_count());
   bvh.prim_ids.resize(refs.size());
-  for (std::size_t i = 0; i < refs.size(); ++i) bvh.prim_ids[i] = refs[i].id;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, refs.size(), kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) bvh.prim_ids[i] = refs[i].id;
+  });
   return bvh;
 }
 

@@ -220,7 +220,7 @@ class SbvhBuilder {
     SpatialSplit spatial;
     if (depth < options_.max_sah_depth) {
       object = bvh2_build::find_object_split(std::span<const Ref>(refs_.data() + begin, count), centroid_bounds, bins_,
-                                             options_.leaf_granularity, centroid_of);
+                                             options_.leaf_granularity);
       // Spatial splits only where the object split leaves the children
       // overlapping (or finds none: the centroids coincide).
       if (object.axis < 0 || intersection(object.left, object.right).half_area() > min_overlap_)

@@ -6,11 +6,13 @@
 // exactly as testing every triangle does.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include "bvh_test_util.h"
 
@@ -237,6 +239,25 @@ TEST_P(WideBvhBuild, FindsTheClosedSphereFromInsideAndNothingOutsideIt) {
   }
   const Ray away{{3, 0, 0}, 0.0f, {1, 0, 0}, kInf};
   EXPECT_FALSE(intersect_wide(bvh, away).hit());
+  });
+}
+
+// The build and the collapse run in parallel (TBB), yet the wide tree, its
+// layout included, is the same for any number of threads: results and
+// memory do not depend on the machine's core count.
+TEST_P(WideBvhBuild, TheTreeIsTheSameBuiltOnOneThreadOrTwo) {
+  const auto tris = random_soup(20000, 11);  // above the parallel thresholds
+  for_each_width([&](auto width) {
+    constexpr int W = width();
+    WideBvh<W> one, two;
+    tbb::task_arena(1).execute([&] { one = build<W>(tris); });
+    tbb::task_arena(2).execute([&] { two = build<W>(tris); });
+    ASSERT_EQ(one.nodes.size(), two.nodes.size());
+    ASSERT_EQ(one.packs.size(), two.packs.size());
+    EXPECT_EQ(one.depth, two.depth);
+    EXPECT_EQ(0, std::memcmp(one.nodes.data(), two.nodes.data(), one.nodes.size() * sizeof(WideNode<W>)));
+    EXPECT_EQ(0, std::memcmp(one.packs.data(), two.packs.data(), one.packs.size() * sizeof(TrianglePack<W>)));
+    EXPECT_TRUE(one.pack_prims == two.pack_prims);
   });
 }
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "raybench/bvh/bvh2.h"
+#include "raybench/bvh/huge_pages.h"
 #include "raybench/simd/triangle8_watertight.h"
 #include "raybench/simd/wide_box.h"
 #include "raybench/simd/wide_triangle.h"
@@ -68,10 +69,10 @@ struct WideBvh {
   static constexpr std::uint32_t kLeafBit = 0x80000000u;
   static constexpr std::uint32_t kEmptyChild = 0xffffffffu;
 
-  std::vector<WideNode<W>> nodes;               // nodes[0] is the root
-  std::vector<TrianglePack<W>> packs;           // WideLeaves::kMollerTrumbore: up to W triangles each
-  std::vector<TriangleVertices8> vertex_packs;  // WideLeaves::kVertices (W = 8): the same packs as vertices
-  std::vector<std::int32_t> pack_prims;         // W per pack: input triangle index, -1 in unused lanes
+  HugePageVector<WideNode<W>> nodes;               // nodes[0] is the root
+  HugePageVector<TrianglePack<W>> packs;           // WideLeaves::kMollerTrumbore: up to W triangles each
+  HugePageVector<TriangleVertices8> vertex_packs;  // WideLeaves::kVertices (W = 8): the same packs as vertices
+  HugePageVector<std::int32_t> pack_prims;         // W per pack: input triangle index, -1 in unused lanes
   std::size_t depth = 0;                        // levels below the root; bounds the traversal stack
 
   std::size_t memory_bytes() const {
