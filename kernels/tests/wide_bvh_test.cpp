@@ -328,7 +328,8 @@ TEST(WideBvhTraversal, ARaysOctantIsWhereItsSlabTestEntersByTheUpperPlane) {
 
 #if defined(__AVX2__)
 // The SIMD traversal permutes and compacts what the scalar fallback pushes
-// lane by lane: both must leave the same entries in the same order.
+// lane by lane: both must leave the same entries in the same order, far to
+// near with entry distances for the closest hit, in lane order for any hit.
 template <int W>
 void expect_compacted_push_equals_lane_by_lane_push() {
   std::mt19937 rng(5);
@@ -349,7 +350,7 @@ void expect_compacted_push_equals_lane_by_lane_push() {
 
     wide_bvh_detail::Stack<W> scalar, simd;
     scalar.top = simd.top = 3;  // pushes land above what is there
-    wide_bvh_detail::push_far_to_near_scalar(scalar, node, octant, mask, entry);
+    wide_bvh_detail::push_children_scalar<true>(scalar, node, octant, mask, entry);
     const auto permutation = wide_bvh_detail::unpack_lanes<W, bits>(node.far_to_near[octant]);
     // The mask in rank order, as the traversal computes it from the permuted hit lanes.
     unsigned ranked = 0;
@@ -360,6 +361,17 @@ void expect_compacted_push_equals_lane_by_lane_push() {
     for (int i = 3; i < scalar.top; ++i) {
       EXPECT_EQ(simd.ref[i], scalar.ref[i]);
       EXPECT_EQ(simd.entry[i], scalar.entry[i]);
+    }
+
+    wide_bvh_detail::Stack<W> any_scalar, any_simd;
+    any_scalar.top = any_simd.top = 3;
+    wide_bvh_detail::push_children_scalar<false>(any_scalar, node, octant, mask, entry);
+    wide_bvh_detail::push_compacted(any_simd, simd::IntLanes<W>::load(node.child), mask);
+    ASSERT_EQ(any_simd.top, any_scalar.top);
+    for (int i = 3, lane = 0; i < any_scalar.top; ++i, ++lane) {
+      while (!(mask >> lane & 1u)) ++lane;
+      EXPECT_EQ(any_scalar.ref[i], node.child[lane]) << "lane order";
+      EXPECT_EQ(any_simd.ref[i], any_scalar.ref[i]);
     }
   }
 }

@@ -5,9 +5,15 @@
 // distances: one permutation orders them and a table-driven compaction
 // pushes them with two stores, branch-free. Their entry distances go on the
 // stack too, so a subtree farther than the current hit is skipped when
-// popped. Leaves are tested W triangles at once. Any hit returns at the first
-// hit in the interval, and pushes leaves above inner nodes so that they are
-// tested first.
+// popped. Leaves are tested W triangles at once.
+// Any hit (shadow rays) returns at the first hit in the interval and orders
+// nothing: the children entered are pushed in the node's lane order, ref
+// only (its interval never shrinks, so no entry distance is needed), as
+// Embree's any-hit traversal does. Measured on the default suite's shadow
+// rays, one thread: 1.13-1.5x faster than the far-to-near order with leaves
+// pushed last (Lucy 1.5x, Conference 1.3x), except Sponza (0.95x). Nearest
+// first mostly visits the surface around the ray's origin, which a shadow
+// ray leaves without hitting.
 // The leaf test and the box test are policies: WideMollerTrumbore, or
 // Bvh8Watertight (8 wide, needs WideLeaves::kVertices); Slab or SlabRobust
 // (the conservative test: with the watertight leaves no ray leaks through
@@ -42,15 +48,16 @@ struct Stack {
 
 // Pushes the children of `node` in `lanes` (bit i: lane i) in the node's
 // far-to-near order for `octant`, lane by lane: the scalar form of the
-// compacted SIMD push below, same order.
-template <int W>
-inline void push_far_to_near_scalar(Stack<W>& stack, const WideNode<W>& node, int octant, unsigned lanes,
-                                    const float entry[W]) {
+// compacted SIMD push below, same order. With `ordered` false, in lane
+// order and without entry distances (any hit).
+template <bool Ordered, int W>
+inline void push_children_scalar(Stack<W>& stack, const WideNode<W>& node, int octant, unsigned lanes,
+                                 const float entry[W]) {
   for (int rank = 0; rank < W; ++rank) {
-    const int lane = far_to_near_lane(node, octant, rank);
+    const int lane = Ordered ? far_to_near_lane(node, octant, rank) : rank;
     if (!(lanes >> lane & 1u)) continue;
     stack.ref[stack.top] = node.child[lane];
-    stack.entry[stack.top] = entry[lane];
+    if constexpr (Ordered) stack.entry[stack.top] = entry[lane];
     ++stack.top;
   }
 }
@@ -82,6 +89,13 @@ inline void push_compacted(Stack<W>& stack, simd::IntLanes<W> refs, simd::FloatL
   const simd::IntLanes<W> pick = unpack_lanes<W, 4>(kCompactLanes<W>[lanes]);
   refs.permute(pick).storeu(stack.ref + stack.top);
   entry.permute(pick).storeu(stack.entry + stack.top);
+  stack.top += __builtin_popcount(lanes);
+}
+
+// The same for refs alone (any hit).
+template <int W>
+inline void push_compacted(Stack<W>& stack, simd::IntLanes<W> refs, unsigned lanes) {
+  refs.permute(unpack_lanes<W, 4>(kCompactLanes<W>[lanes])).storeu(stack.ref + stack.top);
   stack.top += __builtin_popcount(lanes);
 }
 #endif
@@ -127,7 +141,9 @@ inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
   while (stack.top > 0) {
     --stack.top;
     const std::uint32_t ref = stack.ref[stack.top];
-    if (!reachable(stack.entry[stack.top], tmax)) continue;  // a hit closer than this subtree was found meanwhile
+    // A hit closer than this subtree was found meanwhile (closest hit only:
+    // any hit returns at its first).
+    if (!AnyHit && !reachable(stack.entry[stack.top], tmax)) continue;
     if (ref & WideBvh<W>::kLeafBit) {
       const std::uint32_t pack = ref & ~WideBvh<W>::kLeafBit;
       TriangleHit th{};  // set when a lane hits (initialised: the scalar fallback sets it conditionally)
@@ -141,35 +157,24 @@ inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
     }
     const WideNode<W>& node = bvh.nodes[ref];
 #if defined(__AVX2__)
-    // Permute the node's lanes into far-to-near order, then push the entered
-    // ones compacted (for any hit: inner nodes first, leaves on top; the leaf
-    // bit is the sign bit).
     const BoxHits<W> box = slab_lanes<BoxTest>(r, tmax, node.bounds);
-    const simd::IntLanes<W> order =
-        wide_bvh_detail::unpack_lanes<W, WideNode<W>::kOrderBits>(node.far_to_near[octant]);
-    const unsigned entered = box.hit.permute(order).mask();
-    if (!entered) continue;
-    const simd::IntLanes<W> refs = simd::IntLanes<W>::load(node.child).permute(order);
-    const simd::FloatLanes<W> entry = box.t_entry.permute(order);
     if constexpr (AnyHit) {
-      const unsigned leaves = refs.sign_mask();
-      wide_bvh_detail::push_compacted(stack, refs, entry, entered & ~leaves);
-      wide_bvh_detail::push_compacted(stack, refs, entry, entered & leaves);
+      const unsigned entered = box.hit.mask();
+      if (entered) wide_bvh_detail::push_compacted(stack, simd::IntLanes<W>::load(node.child), entered);
     } else {
-      wide_bvh_detail::push_compacted(stack, refs, entry, entered);
+      // Permute the node's lanes into far-to-near order, then push the
+      // entered ones compacted.
+      const simd::IntLanes<W> order =
+          wide_bvh_detail::unpack_lanes<W, WideNode<W>::kOrderBits>(node.far_to_near[octant]);
+      const unsigned entered = box.hit.permute(order).mask();
+      if (!entered) continue;
+      const simd::IntLanes<W> refs = simd::IntLanes<W>::load(node.child).permute(order);
+      wide_bvh_detail::push_compacted(stack, refs, box.t_entry.permute(order), entered);
     }
 #else
     alignas(32) float entry[W];
     const unsigned entered = intersect_boxes<BoxTest>(r, tmax, node.bounds, entry);
-    if constexpr (AnyHit) {
-      unsigned leaves = 0;
-      for (int lane = 0; lane < W; ++lane)
-        leaves |= static_cast<unsigned>((node.child[lane] & WideBvh<W>::kLeafBit) != 0) << lane;
-      wide_bvh_detail::push_far_to_near_scalar(stack, node, octant, entered & ~leaves, entry);
-      wide_bvh_detail::push_far_to_near_scalar(stack, node, octant, entered & leaves, entry);
-    } else {
-      wide_bvh_detail::push_far_to_near_scalar(stack, node, octant, entered, entry);
-    }
+    wide_bvh_detail::push_children_scalar<!AnyHit>(stack, node, octant, entered, entry);
 #endif
   }
   return hit;
