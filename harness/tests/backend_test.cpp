@@ -6,6 +6,9 @@
 #include <cmath>
 #include <limits>
 
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
 #include "error.h"
 #include "scene.h"
 #include "test_util.h"
@@ -127,6 +130,17 @@ TEST_P(EveryBackend, TwoThreadsGiveTheSameAnswersAsOne) {
     hits += one[i].hit();
   }
   EXPECT_EQ(hits, 10000);  // straight down onto the terrain
+}
+
+// Backends made and built for one thread leave the process's TBB thread
+// limit at what the machine offers: Embree's "threads=N" device option sets
+// a process-wide tbb::global_control, under which every other backend's
+// 2-thread build ran on one thread.
+TEST_P(EveryBackend, LeaveTheProcessWideThreadLimitAlone) {
+  const auto one_thread = make_backend(GetParam(), BackendConfig{1});  // beside the fixture's, also for one thread
+  TraceExecutor(1).run([&] { one_thread->build(square_scene()); });
+  EXPECT_EQ(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism),
+            static_cast<std::size_t>(tbb::info::default_concurrency()));
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, EveryBackend, ::testing::ValuesIn(every_correct_backend()), [](const auto& info) {
