@@ -97,6 +97,22 @@ void sweep_bins(const std::array<BBox, MaxBins>& boxes, const std::array<std::si
   }
 }
 
+#if defined(__SSE2__)
+// A Vec3f as the first three lanes of an SSE vector (lane 3 zero): exactly
+// three floats read, never past the vector.
+inline __m128 load_vec3(const Vec3f& v) {
+  return _mm_movelh_ps(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(&v.x))), _mm_load_ss(&v.z));
+}
+
+// The box whose corners are the first three lanes of `lower` and `upper`.
+inline BBox bbox_from_lanes(__m128 lower, __m128 upper) {
+  alignas(16) float l[4], u[4];
+  _mm_store_ps(l, lower);
+  _mm_store_ps(u, upper);
+  return BBox{{l[0], l[1], l[2]}, {u[0], u[1], u[2]}};
+}
+#endif
+
 // Bins `refs` on all three axes in one pass: bin_bounds[axis][b] and
 // bin_count[axis][b] for b < bins, a reference binned by its box's centre
 // (BBox::center, the centroid every builder splits by). The build's hottest
@@ -121,16 +137,12 @@ void bin_all_axes(std::span<const Ref> refs, const float lo[3], const float scal
         upper[set][axis][b] = _mm_set1_ps(-std::numeric_limits<float>::infinity());
         count[set][axis][b] = 0;
       }
-  // Exactly three floats: never a read past the box.
-  const auto load3 = [](const Vec3f& v) {
-    return _mm_movelh_ps(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(&v.x))), _mm_load_ss(&v.z));
-  };
   const __m128 lo4 = _mm_setr_ps(lo[0], lo[1], lo[2], 0.0f), scale4 = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
   const __m128 half = _mm_set1_ps(0.5f), zero = _mm_setzero_ps(), last_bin = _mm_set1_ps(static_cast<float>(bins - 1));
   for (std::size_t i = 0; i < refs.size(); ++i) {
     const Ref& r = refs[i];
     const int set = static_cast<int>(i & 1u);
-    const __m128 ref_lower = load3(r.bounds.lower), ref_upper = load3(r.bounds.upper);
+    const __m128 ref_lower = load_vec3(r.bounds.lower), ref_upper = load_vec3(r.bounds.upper);
     // centroid_bin on three axes: max_ps(f, 0) is 0 for a NaN f, as below lo;
     // min with bins - 1 before truncation gives the last bin from bins - 1 on.
     const __m128 centre = _mm_mul_ps(_mm_add_ps(ref_lower, ref_upper), half);
@@ -146,13 +158,8 @@ void bin_all_axes(std::span<const Ref> refs, const float lo[3], const float scal
   }
   for (int axis = 0; axis < 3; ++axis)
     for (int b = 0; b < bins; ++b) {
-      alignas(16) float l[2][4], u[2][4];
-      for (int set = 0; set < 2; ++set) {
-        _mm_store_ps(l[set], lower[set][axis][b]);
-        _mm_store_ps(u[set], upper[set][axis][b]);
-      }
-      BBox box{{l[0][0], l[0][1], l[0][2]}, {u[0][0], u[0][1], u[0][2]}};
-      box.extend(BBox{{l[1][0], l[1][1], l[1][2]}, {u[1][0], u[1][1], u[1][2]}});
+      BBox box = bbox_from_lanes(lower[0][axis][b], upper[0][axis][b]);
+      box.extend(bbox_from_lanes(lower[1][axis][b], upper[1][axis][b]));
       bin_bounds[axis][b] = box;
       bin_count[axis][b] = count[0][axis][b] + count[1][axis][b];
     }

@@ -29,7 +29,7 @@ namespace {
 // than stored (the build is bound by reading references).
 struct PrimRef {
   BBox bounds;
-  std::uint32_t id;  // also read (and ignored) as the fourth lane of bounds.upper
+  std::uint32_t id;
 };
 
 using bvh2_build::BuildBuffer;
@@ -45,7 +45,7 @@ struct RangeBounds {
   __m128 centroid_lower = lower, centroid_upper = upper;
 
   void extend(const PrimRef& r) {
-    const __m128 l = _mm_loadu_ps(&r.bounds.lower.x), u = _mm_loadu_ps(&r.bounds.upper.x);  // lane 3 unused
+    const __m128 l = bvh2_build::load_vec3(r.bounds.lower), u = bvh2_build::load_vec3(r.bounds.upper);
     const __m128 c = _mm_mul_ps(_mm_add_ps(l, u), _mm_set1_ps(0.5f));
     lower = _mm_min_ps(l, lower);
     upper = _mm_max_ps(u, upper);
@@ -58,14 +58,8 @@ struct RangeBounds {
     centroid_lower = _mm_min_ps(b.centroid_lower, centroid_lower);
     centroid_upper = _mm_max_ps(b.centroid_upper, centroid_upper);
   }
-  static BBox box(__m128 l, __m128 u) {
-    alignas(16) float lf[4], uf[4];
-    _mm_store_ps(lf, l);
-    _mm_store_ps(uf, u);
-    return BBox{{lf[0], lf[1], lf[2]}, {uf[0], uf[1], uf[2]}};
-  }
-  BBox bounds() const { return box(lower, upper); }
-  BBox centroids() const { return box(centroid_lower, centroid_upper); }
+  BBox bounds() const { return bvh2_build::bbox_from_lanes(lower, upper); }
+  BBox centroids() const { return bvh2_build::bbox_from_lanes(centroid_lower, centroid_upper); }
 #else
   BBox box, centroid_box;
   void extend(const PrimRef& r) {
