@@ -22,15 +22,14 @@ struct EmbreeOptions {
 
 class EmbreeBackend final : public Backend {
  public:
-  EmbreeBackend(std::string name, EmbreeOptions options, const BackendConfig& config)
+  EmbreeBackend(std::string name, EmbreeOptions options)
       : name_(std::move(name)), options_(options) {
     // No "threads=N": Embree would enforce it with a process-wide
     // tbb::global_control, replaced by each newer device, so while a
     // 1-thread Embree backend was the newest every other backend's 2-thread
     // build ran on one thread (ours measured 1.0x instead of 1.8x). Embree's
     // build runs in the caller's TBB arena instead, which the harness sizes
-    // to config.threads for every backend alike (TraceExecutor::run).
-    (void)config;
+    // to BackendConfig::threads for every backend alike (TraceExecutor::run).
     const std::string device_config = "verbose=0";
     device_ = rtcNewDevice(device_config.c_str());
     if (!device_) throw std::runtime_error("embree: cannot create a device (" + device_config + ")");
@@ -140,7 +139,7 @@ class EmbreeBackend final : public Backend {
 }  // namespace
 
 std::unique_ptr<Backend> make_embree_backend(const std::string& name, const std::vector<std::string>& options,
-                                             const BackendConfig& config) {
+                                             const BackendConfig&) {
   EmbreeOptions parsed;
   for (const std::string& o : options) {
     if (o == "low") parsed.quality = RTC_BUILD_QUALITY_LOW;
@@ -149,7 +148,7 @@ std::unique_ptr<Backend> make_embree_backend(const std::string& name, const std:
     else if (o == "robust") parsed.robust = true;
     else throw InputError("", fmt::format("backend '{}': unknown embree option '{}' (known: low, medium, high, robust)", name, o));
   }
-  return std::make_unique<EmbreeBackend>(name, parsed, config);
+  return std::make_unique<EmbreeBackend>(name, parsed);
 }
 
 std::vector<BackendInfo> embree_backend_names() {
