@@ -252,7 +252,7 @@ void add_batched(std::vector<Case>& cases, std::size_t pairs) {
 
     const auto triangle_case = [&](const char* form, int (*fn)(const Ray&, float, const Triangle8&, TriangleHit&)) {
       Case c;
-      c.result = describe("triangle", "mt", form, hit, "fast", 8 * rays);
+      c.result = describe("triangle", "mt_normal", form, hit, "fast", 8 * rays);
       c.run = [tri_rays, packs, fn] {
         std::size_t hits = 0;
         // One closest-hit call per ray, as a BVH leaf makes it; it reports

@@ -2,7 +2,8 @@
 // 8-wide (bvh8: AVX2) or 4-wide (bvh4: SSE) nodes, traversed with one SIMD
 // slab test per node and leaves of up to W triangles tested at once.
 // Options, in any order, each at most once:
-//   a triangle test: mt (Möller–Trumbore, simd/wide_triangle.h, the default)
+//   a triangle test: mt (Möller–Trumbore in its stored-normal form,
+//     prim/triangle_mt_normal.h, simd/wide_triangle.h; the default)
 //     or, 8 wide only, watertight (Woop et al. 2013, simd/triangle8_watertight.h);
 //   robust: the conservative wide box test (Ize's padding), so that
 //     bvh8:watertight:robust leaks no ray through the tree either;

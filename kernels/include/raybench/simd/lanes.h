@@ -6,12 +6,17 @@
 // Comparisons are ordered and non-signalling (false for NaN), and min/max
 // return their second operand when either is NaN, as the scalar kernels'
 // comparisons do. Only with AVX2 (raybench::kHaveAvx2); without it the wide
-// kernels run their scalar forms.
+// kernels run their scalar forms. fmadd is one fused multiply-add, as
+// std::fma: every AVX2 CPU has FMA3, and a build that targets AVX2 without
+// it is refused rather than given a slower or differently rounded form.
 #pragma once
 
 #include <cstdint>
 
 #if defined(__AVX2__)
+#if !defined(__FMA__)
+#error "raybench's wide kernels need FMA3 with AVX2: compile with -march=native or -mavx2 -mfma"
+#endif
 #include <immintrin.h>
 
 namespace raybench::simd {
@@ -47,18 +52,25 @@ struct FloatLanes<8> {
   FloatLanes operator*(FloatLanes o) const { return {_mm256_mul_ps(v, o.v)}; }
   FloatLanes operator/(FloatLanes o) const { return {_mm256_div_ps(v, o.v)}; }
   FloatLanes operator&(FloatLanes o) const { return {_mm256_and_ps(v, o.v)}; }
+  FloatLanes operator^(FloatLanes o) const { return {_mm256_xor_ps(v, o.v)}; }
   FloatLanes operator<=(FloatLanes o) const { return {_mm256_cmp_ps(v, o.v, _CMP_LE_OQ)}; }
   FloatLanes operator<(FloatLanes o) const { return {_mm256_cmp_ps(v, o.v, _CMP_LT_OQ)}; }
   FloatLanes operator>=(FloatLanes o) const { return {_mm256_cmp_ps(v, o.v, _CMP_GE_OQ)}; }
   FloatLanes operator>(FloatLanes o) const { return {_mm256_cmp_ps(v, o.v, _CMP_GT_OQ)}; }
   FloatLanes operator!=(FloatLanes o) const { return {_mm256_cmp_ps(v, o.v, _CMP_NEQ_OQ)}; }
   FloatLanes abs() const { return {_mm256_andnot_ps(_mm256_set1_ps(-0.0f), v)}; }
+  // The sign bits alone (x ^ y.sign() flips x's sign where y is negative).
+  FloatLanes sign() const { return {_mm256_and_ps(_mm256_set1_ps(-0.0f), v)}; }
   FloatLanes permute(IntLanes<8> index) const { return {_mm256_permutevar8x32_ps(v, index.v)}; }
   unsigned mask() const { return static_cast<unsigned>(_mm256_movemask_ps(v)); }
 };
 // max(a, b) / min(a, b): b when either is NaN.
 inline FloatLanes<8> max(FloatLanes<8> a, FloatLanes<8> b) { return {_mm256_max_ps(a.v, b.v)}; }
 inline FloatLanes<8> min(FloatLanes<8> a, FloatLanes<8> b) { return {_mm256_min_ps(a.v, b.v)}; }
+// a * b + c, rounded once (std::fma).
+inline FloatLanes<8> fmadd(FloatLanes<8> a, FloatLanes<8> b, FloatLanes<8> c) { return {_mm256_fmadd_ps(a.v, b.v, c.v)}; }
+// a * b - c, rounded once (std::fma(a, b, -c)).
+inline FloatLanes<8> fmsub(FloatLanes<8> a, FloatLanes<8> b, FloatLanes<8> c) { return {_mm256_fmsub_ps(a.v, b.v, c.v)}; }
 
 template <>
 struct IntLanes<4> {
@@ -86,17 +98,24 @@ struct FloatLanes<4> {
   FloatLanes operator*(FloatLanes o) const { return {_mm_mul_ps(v, o.v)}; }
   FloatLanes operator/(FloatLanes o) const { return {_mm_div_ps(v, o.v)}; }
   FloatLanes operator&(FloatLanes o) const { return {_mm_and_ps(v, o.v)}; }
+  FloatLanes operator^(FloatLanes o) const { return {_mm_xor_ps(v, o.v)}; }
   FloatLanes operator<=(FloatLanes o) const { return {_mm_cmp_ps(v, o.v, _CMP_LE_OQ)}; }
   FloatLanes operator<(FloatLanes o) const { return {_mm_cmp_ps(v, o.v, _CMP_LT_OQ)}; }
   FloatLanes operator>=(FloatLanes o) const { return {_mm_cmp_ps(v, o.v, _CMP_GE_OQ)}; }
   FloatLanes operator>(FloatLanes o) const { return {_mm_cmp_ps(v, o.v, _CMP_GT_OQ)}; }
   FloatLanes operator!=(FloatLanes o) const { return {_mm_cmp_ps(v, o.v, _CMP_NEQ_OQ)}; }
   FloatLanes abs() const { return {_mm_andnot_ps(_mm_set1_ps(-0.0f), v)}; }
+  // The sign bits alone (x ^ y.sign() flips x's sign where y is negative).
+  FloatLanes sign() const { return {_mm_and_ps(_mm_set1_ps(-0.0f), v)}; }
   FloatLanes permute(IntLanes<4> index) const { return {_mm_permutevar_ps(v, index.v)}; }
   unsigned mask() const { return static_cast<unsigned>(_mm_movemask_ps(v)); }
 };
 inline FloatLanes<4> max(FloatLanes<4> a, FloatLanes<4> b) { return {_mm_max_ps(a.v, b.v)}; }
 inline FloatLanes<4> min(FloatLanes<4> a, FloatLanes<4> b) { return {_mm_min_ps(a.v, b.v)}; }
+// a * b + c, rounded once (std::fma).
+inline FloatLanes<4> fmadd(FloatLanes<4> a, FloatLanes<4> b, FloatLanes<4> c) { return {_mm_fmadd_ps(a.v, b.v, c.v)}; }
+// a * b - c, rounded once (std::fma(a, b, -c)).
+inline FloatLanes<4> fmsub(FloatLanes<4> a, FloatLanes<4> b, FloatLanes<4> c) { return {_mm_fmsub_ps(a.v, b.v, c.v)}; }
 
 }  // namespace raybench::simd
 #endif
