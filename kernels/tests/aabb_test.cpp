@@ -2,7 +2,7 @@
 // known answers worked by hand, mostly on the unit box [0,1]^3.
 //
 //   AllBoxTests    properties every variant has, the seed included
-//   FixedBoxTests  what Slab and SlabRobust do and the seed does not
+//   FixedBoxTests  what Slab, SlabRobust and SlabFma do and the seed does not
 //   SlabSeed.KnownFailure_*   the seed note's bugs, pinned as documented behaviour
 //   Slab / SlabRobust         rounding: the unpadded test misses a box the exact
 //                             ray touches, the padded one never does
@@ -15,6 +15,7 @@
 
 #include "raybench/prim/aabb.h"
 #include "raybench/prim/aabb_slab.h"
+#include "raybench/prim/aabb_slab_fma.h"
 #include "raybench/prim/aabb_slab_robust.h"
 #include "raybench/prim/aabb_slab_seed.h"
 
@@ -69,7 +70,7 @@ template <typename Box>
 
 template <typename Box>
 class AllBoxTests : public ::testing::Test {};
-using AllBoxes = ::testing::Types<SlabSeed, Slab, SlabRobust>;
+using AllBoxes = ::testing::Types<SlabSeed, Slab, SlabRobust, SlabFma>;
 TYPED_TEST_SUITE(AllBoxTests, AllBoxes);
 
 TYPED_TEST(AllBoxTests, ObliqueHitReportsEntryAndExit) {
@@ -272,7 +273,7 @@ TYPED_TEST(AllBoxTests, MissLeavesTheOutputUntouched) {
 
 template <typename Box>
 class FixedBoxTests : public ::testing::Test {};
-using FixedBoxes = ::testing::Types<Slab, SlabRobust>;
+using FixedBoxes = ::testing::Types<Slab, SlabRobust, SlabFma>;
 TYPED_TEST_SUITE(FixedBoxTests, FixedBoxes);
 
 TYPED_TEST(FixedBoxTests, TnearClipsAndIsClosed) {
@@ -541,9 +542,11 @@ TEST(BoxTests, NamesAndAccuracyClasses) {
   EXPECT_EQ(SlabSeed::name, "slab_seed");
   EXPECT_EQ(Slab::name, "slab");
   EXPECT_EQ(SlabRobust::name, "slab_robust");
+  EXPECT_EQ(SlabFma::name, "slab_fma");
   EXPECT_EQ(SlabSeed::accuracy, AccuracyClass::kEpsilon);
   EXPECT_EQ(Slab::accuracy, AccuracyClass::kFast);
   EXPECT_EQ(SlabRobust::accuracy, AccuracyClass::kConservative);
+  EXPECT_EQ(SlabFma::accuracy, AccuracyClass::kFast);
 }
 
 }  // namespace

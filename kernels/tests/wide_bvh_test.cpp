@@ -171,6 +171,27 @@ TEST_P(WideBvhBuild, EveryRayKindOnAMeshMatchesBruteForce) {
   });
 }
 
+// Rays with zero direction components (either sign) take the plain slab
+// test's loop instead of the fused one (aabb_slab_fma.h), whose NaN
+// distances would not bound the slabs they run along: they find what brute
+// force finds.
+TEST_P(WideBvhBuild, AxisParallelRaysMatchBruteForce) {
+  const auto tris = testing::sphere_cluster();
+  for_each_width([&](auto width) {
+    const auto bvh = build<width()>(tris);
+    std::vector<Ray> rays = testing::rays_at(tris, "aimed", 3000, 60);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      Ray& r = rays[i];
+      const int axis = static_cast<int>(i % 3);
+      const float zero = i % 2 ? 0.0f : -0.0f;
+      r.org[axis] += r.dir[axis];  // still through the point org + dir, which it aimed at
+      r.dir[axis] = zero;
+      if (i % 7 == 0) r.dir[(axis + 1) % 3] = zero;  // two zero components
+    }
+    EXPECT_GT(expect_same_hits_as_brute_force(bvh, tris, rays), 300);
+  });
+}
+
 // Watertight leaves (WideLeaves::kVertices), with plain and conservative
 // traversal, against the scalar watertight test on every triangle. The
 // closest t may differ by rounding where two triangles are within an ulp

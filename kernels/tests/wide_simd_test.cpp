@@ -112,9 +112,10 @@ void expect_boxes_simd_equals_scalar() {
       r.org.x = boxes[0].lower.x;
     }
     const Slab::Precomputed pre = Slab::precompute(r);
+    const float tmax = i % 5 == 0 ? 1.0f : kInf;  // clipped by tmax too
     alignas(32) float e_simd[W], e_scalar[W];
-    const unsigned m_simd = intersect_boxes_simd<BoxTest>(pre, kInf, packed, e_simd);
-    const unsigned m_scalar = intersect_boxes_scalar<BoxTest>(pre, kInf, packed, e_scalar);
+    const unsigned m_simd = intersect_boxes_simd<BoxTest>(pre, tmax, packed, e_simd);
+    const unsigned m_scalar = intersect_boxes_scalar<BoxTest>(pre, tmax, packed, e_scalar);
     ASSERT_EQ(m_simd, m_scalar) << "ray " << i;
     for (int lane = 0; lane < W; ++lane)
       if (m_simd >> lane & 1) {
@@ -129,6 +130,8 @@ TEST(Box8, Avx2AnswersExactlyAsTheScalarSlabTest) { expect_boxes_simd_equals_sca
 TEST(Box8, Avx2AnswersExactlyAsTheScalarRobustSlabTest) { expect_boxes_simd_equals_scalar<SlabRobust, 8>(); }
 TEST(Box4, SseAnswersExactlyAsTheScalarSlabTest) { expect_boxes_simd_equals_scalar<Slab, 4>(); }
 TEST(Box4, SseAnswersExactlyAsTheScalarRobustSlabTest) { expect_boxes_simd_equals_scalar<SlabRobust, 4>(); }
+TEST(Box8, Avx2AnswersExactlyAsTheScalarFusedSlabTest) { expect_boxes_simd_equals_scalar<SlabFma, 8>(); }
+TEST(Box4, SseAnswersExactlyAsTheScalarFusedSlabTest) { expect_boxes_simd_equals_scalar<SlabFma, 4>(); }
 
 TEST(Watertight8, Avx2AnswersExactlyAsTheScalarWoopTestEvenThroughEdgesAndVertices) {
   std::mt19937 rng(3);

@@ -6,7 +6,8 @@
 //     prim/triangle_mt_normal.h, simd/wide_triangle.h; the default)
 //     or, 8 wide only, watertight (Woop et al. 2013, simd/triangle8_watertight.h);
 //   robust: the conservative wide box test (Ize's padding), so that
-//     bvh8:watertight:robust leaks no ray through the tree either;
+//     bvh8:watertight:robust leaks no ray through the tree either; without
+//     it, SlabFma (prim/aabb_slab_fma.h: one fused multiply-add per plane);
 //   a builder from raybench/bvh/bvh2_builders.h ("bvh8:sweep", "bvh4:lbvh");
 //   reinsert: the BVH2 optimised by reinsertion before the collapse
 //     (bvh2_reinsertion.h).
@@ -67,7 +68,7 @@ template <int W, typename Leaf>
 std::unique_ptr<Backend> make_with_box_test(const std::string& name, Bvh2Builder builder, int reinsertion_passes,
                                             bool robust) {
   if (robust) return std::make_unique<WideBvhBackend<W, Leaf, SlabRobust>>(name, builder, reinsertion_passes);
-  return std::make_unique<WideBvhBackend<W, Leaf, Slab>>(name, builder, reinsertion_passes);
+  return std::make_unique<WideBvhBackend<W, Leaf, SlabFma>>(name, builder, reinsertion_passes);
 }
 
 template <int W>

@@ -15,9 +15,10 @@
 // first mostly visits the surface around the ray's origin, which a shadow
 // ray leaves without hitting.
 // The leaf test and the box test are policies: WideMollerTrumbore, or
-// Bvh8Watertight (8 wide, needs WideLeaves::kVertices); Slab or SlabRobust
-// (the conservative test: with the watertight leaves no ray leaks through
-// the tree, as bvh2:watertight:robust).
+// Bvh8Watertight (8 wide, needs WideLeaves::kVertices); SlabFma (the
+// backends' plain test: one fused multiply-add per plane, as Embree's),
+// Slab, or SlabRobust (the conservative test: with the watertight leaves no
+// ray leaks through the tree, as bvh2:watertight:robust).
 #pragma once
 
 #include <array>
@@ -120,12 +121,19 @@ struct Bvh8Watertight {
   }
 };
 
-template <bool AnyHit, typename Leaf = WideMollerTrumbore, typename BoxTest = Slab, int W>
+template <bool AnyHit, typename Leaf = WideMollerTrumbore, typename BoxTest = SlabFma, int W>
 inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
   Hit hit;
   if (bvh.nodes.empty()) return hit;
   const Slab::Precomputed r = Slab::precompute(ray);
+  // The fused box test's loop serves rays with no zero direction component;
+  // the others take Slab's, which is exact for them (aabb_slab_fma.h).
+  if constexpr (std::is_same_v<BoxTest, SlabFma>)
+    if (!SlabFma::fused(r)) return traverse_wide<AnyHit, Leaf, Slab>(bvh, ray);
   const int octant = ray_octant(r);
+#if defined(__AVX2__)
+  const RayLanes<W> ray_lanes = RayLanes<W>::from(r);
+#endif
   const typename Leaf::RayData leaf_ray = Leaf::precompute(ray);
   // A popped subtree farther than the current hit is skipped; the robust
   // test compares with the padded bound, so it never skips what it entered.
@@ -157,7 +165,7 @@ inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
     }
     const WideNode<W>& node = bvh.nodes[ref];
 #if defined(__AVX2__)
-    const BoxHits<W> box = slab_lanes<BoxTest>(r, tmax, node.bounds);
+    const BoxHits<W> box = slab_lanes<BoxTest>(ray_lanes, tmax, node.bounds);
     if constexpr (AnyHit) {
       const unsigned entered = box.hit.mask();
       if (entered) wide_bvh_detail::push_compacted(stack, simd::IntLanes<W>::load(node.child), entered);
@@ -180,11 +188,11 @@ inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
   return hit;
 }
 
-template <typename Leaf = WideMollerTrumbore, typename BoxTest = Slab, int W>
+template <typename Leaf = WideMollerTrumbore, typename BoxTest = SlabFma, int W>
 inline Hit intersect_wide(const WideBvh<W>& bvh, const Ray& ray) {
   return traverse_wide<false, Leaf, BoxTest>(bvh, ray);
 }
-template <typename Leaf = WideMollerTrumbore, typename BoxTest = Slab, int W>
+template <typename Leaf = WideMollerTrumbore, typename BoxTest = SlabFma, int W>
 inline bool occluded_wide(const WideBvh<W>& bvh, const Ray& ray) {
   return traverse_wide<true, Leaf, BoxTest>(bvh, ray).hit();
 }

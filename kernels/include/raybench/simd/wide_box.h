@@ -3,17 +3,21 @@
 // leaves the bound unchanged, a NaN bound misses) over boxes stored
 // structure-of-arrays, as wide BVH nodes store their children (issue 4).
 // With BoxTest = SlabRobust the exit is padded by its rounding error as in
-// prim/aabb_slab_robust.h (Ize 2013): no box the exact ray touches is missed.
+// prim/aabb_slab_robust.h (Ize 2013): no box the exact ray touches is missed;
+// with SlabFma each distance is one fused multiply-add (prim/aabb_slab_fma.h).
 // AVX2 (8 lanes) or SSE (4 lanes) when the compiler targets AVX2, else a
 // scalar loop, same answers.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <span>
 #include <type_traits>
 
+#include "raybench/math/inline.h"
 #include "raybench/prim/aabb_slab.h"
+#include "raybench/prim/aabb_slab_fma.h"
 #include "raybench/prim/aabb_slab_robust.h"
 #include "raybench/simd/lanes.h"
 #include "raybench/simd/wide_triangle.h"  // kHaveAvx2
@@ -73,29 +77,74 @@ struct BoxHits {
   simd::FloatLanes<W> hit, t_entry;
 };
 
+// A ray as the SIMD test reads it, set up once per ray: its origin, 1/d and
+// o/d broadcast to every lane, and where each axis's entry planes lie in a
+// BBoxWide (lower, or upper for a negative 1/d), so a node's test is loads
+// and arithmetic only.
+template <int W>
+struct RayLanes {
+  simd::FloatLanes<W> org[3], inv_dir[3], org_over_dir[3];
+  int near_offset[3];  // from b.lower[a] to axis a's entry planes: 0 (lower) or 3W (upper)
+  float tnear;
+
+  static RayLanes from(const Slab::Precomputed& r) {
+    using F = simd::FloatLanes<W>;
+    RayLanes lanes;
+    for (int a = 0; a < 3; ++a) {
+      lanes.org[a] = F::set1(r.org[a]);
+      lanes.inv_dir[a] = F::set1(r.inv_dir[a]);
+      lanes.org_over_dir[a] = F::set1(r.org[a] * r.inv_dir[a]);
+      lanes.near_offset[a] = r.negative[a] ? 3 * W : 0;
+    }
+    lanes.tnear = r.tnear;
+    return lanes;
+  }
+};
+
+// With BoxTest = SlabFma each distance is one fused multiply-add; the
+// caller has checked SlabFma::fused(r) (every 1/d finite), as
+// intersect_boxes_simd and traverse_wide do once per ray.
 template <typename BoxTest = Slab, int W>
-inline BoxHits<W> slab_lanes(const Slab::Precomputed& r, float tmax, const BBoxWide<W>& b) {
+RAYBENCH_INLINE BoxHits<W> slab_lanes(const RayLanes<W>& r, float tmax, const BBoxWide<W>& b) {
   using F = simd::FloatLanes<W>;
-  F t_entry = F::set1(r.tnear), t_exit = F::set1(tmax);
+  constexpr bool kRobust = std::is_same_v<BoxTest, SlabRobust>;
+  constexpr float kLargest = std::numeric_limits<float>::max();
+  // Slab::overlaps asks entry <= exit and entry < +inf (an entry at +inf is
+  // never reached). With the exit clamped to the largest float, entry <=
+  // exit says both: one comparison per node instead of two and an and. The
+  // clamp goes on tmax (std::min keeps a NaN tmax NaN, a miss), or, for the
+  // robust test, on the padded exit, which may round up to +inf.
+  F t_entry = F::set1(r.tnear), t_exit = F::set1(kRobust ? tmax : std::min(tmax, kLargest));
+  // The box's 6W floats as one array: lower[a] at a * W, upper[a] at (3 + a) * W.
+  static_assert(offsetof(BBoxWide<W>, upper) == 3 * W * sizeof(float) && sizeof(BBoxWide<W>) == 6 * W * sizeof(float));
+  const float* planes = reinterpret_cast<const float*>(&b);
   for (int a = 0; a < 3; ++a) {
-    const float* near_plane = r.negative[a] ? b.upper[a] : b.lower[a];
-    const float* far_plane = r.negative[a] ? b.lower[a] : b.upper[a];
-    const F org = F::set1(r.org[a]), inv = F::set1(r.inv_dir[a]);
+    const F near_plane = F::load(planes + a * W + r.near_offset[a]);
+    const F far_plane = F::load(planes + a * W + (3 * W - r.near_offset[a]));
     // max/min return their second operand when either is NaN: a NaN
     // distance keeps the bound and a NaN bound stays NaN, exactly as
     // Slab::clip's comparisons do.
-    t_entry = max((F::load(near_plane) - org) * inv, t_entry);
-    t_exit = min((F::load(far_plane) - org) * inv, t_exit);
+    if constexpr (std::is_same_v<BoxTest, SlabFma>) {
+      t_entry = max(fmsub(near_plane, r.inv_dir[a], r.org_over_dir[a]), t_entry);
+      t_exit = min(fmsub(far_plane, r.inv_dir[a], r.org_over_dir[a]), t_exit);
+    } else {
+      t_entry = max((near_plane - r.org[a]) * r.inv_dir[a], t_entry);
+      t_exit = min((far_plane - r.org[a]) * r.inv_dir[a], t_exit);
+    }
   }
-  // exit + |exit| * 8u, as SlabRobust::intersect.
-  if constexpr (std::is_same_v<BoxTest, SlabRobust>) t_exit = t_exit + t_exit.abs() * F::set1(SlabRobust::kPad);
-  // Slab::overlaps: entry <= exit, and an entry at +inf is never reached.
-  return {(t_entry <= t_exit) & (t_entry < F::set1(std::numeric_limits<float>::infinity())), t_entry};
+  if constexpr (kRobust) {
+    // exit + |exit| * 8u, as SlabRobust::intersect, then the clamp (min
+    // returns its second operand, the padded exit, when that is NaN).
+    t_exit = min(F::set1(kLargest), t_exit + t_exit.abs() * F::set1(SlabRobust::kPad));
+  }
+  return {t_entry <= t_exit, t_entry};
 }
 
 template <typename BoxTest = Slab, int W>
 inline unsigned intersect_boxes_simd(const Slab::Precomputed& r, float tmax, const BBoxWide<W>& b, float entry[W]) {
-  const BoxHits<W> h = slab_lanes<BoxTest>(r, tmax, b);
+  if constexpr (std::is_same_v<BoxTest, SlabFma>)
+    if (!SlabFma::fused(r)) return intersect_boxes_simd<Slab>(r, tmax, b, entry);
+  const BoxHits<W> h = slab_lanes<BoxTest>(RayLanes<W>::from(r), tmax, b);
   alignas(32) float t[W];
   h.t_entry.storeu(t);
   const unsigned mask = h.hit.mask();
