@@ -66,18 +66,19 @@ RandomPack random_pack(std::mt19937& rng, int i, bool edge_cases, int width = 8)
   return c;
 }
 
-template <int W>
-void expect_triangle_pack_simd_equals_scalar() {
-  std::mt19937 rng(1);
+// 20,000 random packs (random_pack, seeded `seed`), each traced by the SIMD
+// and the scalar form of a pack test (pack(tris), then simd/scalar(case,
+// packed, hit) -> lane): the same lane, and where one hits, the same t, u, v.
+template <typename Pack, typename Simd, typename Scalar>
+void expect_simd_answers_as_scalar(unsigned seed, bool edge_cases, int width, Simd simd, Scalar scalar) {
+  std::mt19937 rng(seed);
   int hits = 0;
   for (int i = 0; i < 20000; ++i) {
-    const RandomPack c = random_pack(rng, i, false, W);
-    const TrianglePack<W> packed = TrianglePack<W>::pack(c.tris);
-    const Ray& r = c.ray;
-    const float tmax = c.tmax;
+    const RandomPack c = random_pack(rng, i, edge_cases, width);
+    const Pack packed = Pack::pack(c.tris);
     TriangleHit a{}, b{};
-    const int lane_simd = intersect_pack_simd(r, tmax, packed, a);
-    const int lane_scalar = intersect_pack_scalar(r, tmax, packed, b);
+    const int lane_simd = simd(c, packed, a);
+    const int lane_scalar = scalar(c, packed, b);
     ASSERT_EQ(lane_simd, lane_scalar) << "ray " << i;
     if (lane_simd < 0) continue;
     ++hits;
@@ -86,6 +87,14 @@ void expect_triangle_pack_simd_equals_scalar() {
     EXPECT_EQ(a.v, b.v);
   }
   EXPECT_GT(hits, 5000);
+}
+
+template <int W>
+void expect_triangle_pack_simd_equals_scalar() {
+  expect_simd_answers_as_scalar<TrianglePack<W>>(
+      1, false, W,
+      [](const RandomPack& c, const TrianglePack<W>& p, TriangleHit& h) { return intersect_pack_simd(c.ray, c.tmax, p, h); },
+      [](const RandomPack& c, const TrianglePack<W>& p, TriangleHit& h) { return intersect_pack_scalar(c.ray, c.tmax, p, h); });
 }
 
 TEST(TrianglePack, Avx2AnswersExactlyAsTheScalarKernel) { expect_triangle_pack_simd_equals_scalar<8>(); }
@@ -134,25 +143,14 @@ TEST(Box8, Avx2AnswersExactlyAsTheScalarFusedSlabTest) { expect_boxes_simd_equal
 TEST(Box4, SseAnswersExactlyAsTheScalarFusedSlabTest) { expect_boxes_simd_equals_scalar<SlabFma, 4>(); }
 
 TEST(Watertight8, Avx2AnswersExactlyAsTheScalarWoopTestEvenThroughEdgesAndVertices) {
-  std::mt19937 rng(3);
-  int hits = 0;
-  for (int i = 0; i < 20000; ++i) {
-    const RandomPack c = random_pack(rng, i, true);
-    const TriangleVertices8 packed = TriangleVertices8::pack(c.tris);
-    const Ray& r = c.ray;
-    const float tmax = c.tmax;
-    const WatertightTriangle::RayData data = WatertightTriangle::precompute(r);
-    TriangleHit a{}, b{};
-    const int lane_simd = intersect8_watertight_avx2(data, tmax, packed, a);
-    const int lane_scalar = intersect8_watertight_scalar(data, tmax, packed, b);
-    ASSERT_EQ(lane_simd, lane_scalar) << "ray " << i;
-    if (lane_simd < 0) continue;
-    ++hits;
-    EXPECT_EQ(a.t, b.t);
-    EXPECT_EQ(a.u, b.u);
-    EXPECT_EQ(a.v, b.v);
-  }
-  EXPECT_GT(hits, 5000);
+  expect_simd_answers_as_scalar<TriangleVertices8>(
+      3, true, 8,
+      [](const RandomPack& c, const TriangleVertices8& p, TriangleHit& h) {
+        return intersect8_watertight_avx2(WatertightTriangle::precompute(c.ray), c.tmax, p, h);
+      },
+      [](const RandomPack& c, const TriangleVertices8& p, TriangleHit& h) {
+        return intersect8_watertight_scalar(WatertightTriangle::precompute(c.ray), c.tmax, p, h);
+      });
 }
 #endif
 
