@@ -72,19 +72,12 @@ struct Slab {
   // The overlap of [tnear, tmax] with the three slab intervals, as computed:
   // empty when !(t_entry <= t_exit). Shared with SlabRobust, which pads it.
   RAYBENCH_INLINE static BoxHit clip(const Precomputed& r, const BBox& box, float tmax) {
-    return clip_by(r, box, tmax, [&](float plane, int axis) { return (plane - r.org[axis]) * r.inv_dir[axis]; });
-  }
-
-  // The same with the ray's distance to a plane given as distance(plane,
-  // axis): SlabFma (aabb_slab_fma.h) computes it with one fused multiply-add.
-  template <typename Distance>
-  RAYBENCH_INLINE static BoxHit clip_by(const Precomputed& r, const BBox& box, float tmax, Distance distance) {
     float entry = r.tnear, exit = tmax;
     for (int axis = 0; axis < 3; ++axis) {
       const float near_plane = r.negative[axis] ? box.upper[axis] : box.lower[axis];
       const float far_plane = r.negative[axis] ? box.lower[axis] : box.upper[axis];
-      const float t_near = distance(near_plane, axis);
-      const float t_far = distance(far_plane, axis);
+      const float t_near = (near_plane - r.org[axis]) * r.inv_dir[axis];
+      const float t_far = (far_plane - r.org[axis]) * r.inv_dir[axis];
       // Written so that a NaN distance (origin on the plane, zero component)
       // is ignored and a NaN bound (invalid ray, NaN tmax) stays NaN.
       entry = t_near > entry ? t_near : entry;

@@ -42,9 +42,18 @@ struct SlabFma {
 
   RAYBENCH_INLINE static BoxHit clip(const Precomputed& r, const BBox& box, float tmax) {
     if (!fused(r)) return Slab::clip(r, box, tmax);
-    return Slab::clip_by(r, box, tmax, [&](float plane, int axis) {
-      return std::fma(plane, r.inv_dir[axis], -(r.org[axis] * r.inv_dir[axis]));  // o/d rounded once, as the SIMD form
-    });
+    float entry = r.tnear, exit = tmax;
+    for (int axis = 0; axis < 3; ++axis) {
+      const float near_plane = r.negative[axis] ? box.upper[axis] : box.lower[axis];
+      const float far_plane = r.negative[axis] ? box.lower[axis] : box.upper[axis];
+      const float org_over_dir = r.org[axis] * r.inv_dir[axis];
+      const float t_near = std::fma(near_plane, r.inv_dir[axis], -org_over_dir);
+      const float t_far = std::fma(far_plane, r.inv_dir[axis], -org_over_dir);
+      // As Slab::clip: a NaN distance (a NaN plane) is ignored, a NaN bound stays NaN.
+      entry = t_near > entry ? t_near : entry;
+      exit = t_far < exit ? t_far : exit;
+    }
+    return {entry, exit};
   }
 
   RAYBENCH_INLINE static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
