@@ -62,21 +62,27 @@ SampleComparison compare_samples(const std::vector<double>& base, const std::vec
   return c;
 }
 
+// The Embree row measured beside `row` in the same run, if any.
+const std::map<std::string, std::string>* embree_row_beside(const ResultsFile& f,
+                                                            const std::map<std::string, std::string>& row) {
+  for (const auto& r : f.rows)
+    if (r.at("backend") == "embree" && r.at("scene") == row.at("scene") && r.at("rayset") == row.at("rayset") &&
+        r.at("threads") == row.at("threads"))
+      return &r;
+  return nullptr;
+}
+
 // Each repetition of a row divided by the median of the Embree row measured
 // in the same run (same scene, ray set, threads); empty without one.
 std::vector<double> ratio_samples(const ResultsFile& f, const std::map<std::string, std::string>& row) {
   if (row.at("backend") == "embree") return {};
-  for (const auto& r : f.rows) {
-    if (r.at("backend") == "embree" && r.at("scene") == row.at("scene") && r.at("rayset") == row.at("rayset") &&
-        r.at("threads") == row.at("threads")) {
-      const double reference = median(parse_samples(r.at("mrays_s_samples")));
-      if (!(reference > 0)) return {};
-      std::vector<double> out = parse_samples(row.at("mrays_s_samples"));
-      for (double& v : out) v /= reference;
-      return out;
-    }
-  }
-  return {};
+  const auto* e = embree_row_beside(f, row);
+  if (!e) return {};
+  const double reference = median(parse_samples(e->at("mrays_s_samples")));
+  if (!(reference > 0)) return {};
+  std::vector<double> out = parse_samples(row.at("mrays_s_samples"));
+  for (double& v : out) v /= reference;
+  return out;
 }
 
 const std::map<std::string, std::string>* find_row(const ResultsFile& f, const std::string& key) {
@@ -124,6 +130,36 @@ ResultsFile read_results_file(const std::string& path) {
     }
   }
   return f;
+}
+
+ResultsFile pool_runs(const std::vector<ResultsFile>& runs) {
+  if (runs.empty()) throw InputError("", "no results to pool");
+  ResultsFile pooled = runs.front();
+  if (runs.size() == 1) return pooled;
+  for (std::size_t i = 1; i < runs.size(); ++i) pooled.path += " + " + runs[i].path;
+  for (auto& row : pooled.rows) {
+    const std::string key = row_key(row);
+    // Every run's own Embree median for this row, and the pooled one.
+    std::vector<double> reference_per_run, all_reference;
+    for (const ResultsFile& run : runs) {
+      const auto* e = embree_row_beside(run, row);
+      const std::vector<double> s = e ? parse_samples(e->at("mrays_s_samples")) : std::vector<double>{};
+      reference_per_run.push_back(s.empty() ? 0.0 : median(s));
+      all_reference.insert(all_reference.end(), s.begin(), s.end());
+    }
+    const double pooled_reference = all_reference.empty() ? 0.0 : median(all_reference);
+    std::string samples;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      const auto* r = find_row(runs[i], key);
+      if (!r) continue;
+      const bool rescale = row.at("backend") != "embree" && reference_per_run[i] > 0 && pooled_reference > 0;
+      for (double v : parse_samples(r->at("mrays_s_samples")))
+        samples += fmt::format("{}{:.9g}", samples.empty() ? "" : ";",
+                               rescale ? v * pooled_reference / reference_per_run[i] : v);
+    }
+    row["mrays_s_samples"] = samples;
+  }
+  return pooled;
 }
 
 const std::vector<std::string>& machine_keys() {

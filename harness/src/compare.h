@@ -27,6 +27,14 @@ struct ResultsFile {
 // Reads a results CSV and its metadata; throws InputError naming the file.
 ResultsFile read_results_file(const std::string& path);
 
+// Several independent runs of the same suite as one baseline: each row's
+// repetitions are concatenated, with every run's samples rescaled by (pooled
+// Embree median / that run's Embree median) so that each sample's ratio to
+// Embree stays the ratio measured within its own run. Deterministic columns
+// and metadata come from the first run; rows absent from it are dropped.
+// One run is returned unchanged.
+ResultsFile pool_runs(const std::vector<ResultsFile>& runs);
+
 // Metadata keys whose difference makes absolute throughput incomparable.
 const std::vector<std::string>& machine_keys();
 // "key: base vs new" for each machine key that differs (or is missing).

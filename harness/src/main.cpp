@@ -187,12 +187,15 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(0.0, 10.0));
 
   // raybench gate
-  std::string gate_baseline, gate_config = std::string(RAYBENCH_SOURCE_DIR) + "/results/gate.toml";
-  std::vector<std::string> gate_currents;
+  std::string gate_config = std::string(RAYBENCH_SOURCE_DIR) + "/results/gate.toml";
+  std::vector<std::string> gate_baselines, gate_currents;
   bool gate_verbose = false;
   CLI::App* gate_cmd = app.add_subcommand(
       "gate", "Fail (exit 1) when the current results regress against a baseline beyond the thresholds of a gate config");
-  gate_cmd->add_option("--baseline", gate_baseline, "Baseline results CSV")->required();
+  gate_cmd->add_option("--baseline", gate_baselines,
+                       "Baseline results CSV; give it more than once to pool independent runs of the baseline "
+                       "(each repetition keeps the ratio to Embree of its own run)")
+      ->required();
   gate_cmd->add_option("--current", gate_currents,
                        "Current results CSV; give it twice (two independent runs) to count a throughput "
                        "regression only when both show it")
@@ -235,7 +238,9 @@ int run(int argc, char** argv) {
   }
   if (*gate_cmd) {
     const GateConfig config = load_gate_config(gate_config);
-    const ResultsFile baseline = read_results_file(gate_baseline);
+    std::vector<ResultsFile> baseline_runs;
+    for (const std::string& path : gate_baselines) baseline_runs.push_back(read_results_file(path));
+    const ResultsFile baseline = pool_runs(baseline_runs);
     std::vector<ResultsFile> currents;
     for (const std::string& path : gate_currents) {
       currents.push_back(read_results_file(path));
@@ -253,7 +258,7 @@ int run(int argc, char** argv) {
     for (const auto& n : g.notes) std::cout << "note: " << n << "\n";
     for (const auto& f : g.failures) std::cout << "FAIL: " << f << "\n";
     std::cout << fmt::format("gate: {} ({} rows compared against {}, {} failure{})\n", g.failures.empty() ? "PASS" : "FAIL",
-                             current.rows.size(), gate_baseline, g.failures.size(), g.failures.size() == 1 ? "" : "s");
+                             current.rows.size(), baseline.path, g.failures.size(), g.failures.size() == 1 ? "" : "s");
     return g.failures.empty() ? 0 : 1;
   }
   if (*accuracy_kernels_cmd) {

@@ -342,6 +342,24 @@ class CompareAndGate(CliTestCase):
         self.assertEqual(real.returncode, 1, real.stdout)
         self.assertIn("confirmed by another run", real.stdout)
 
+    def test_pooled_baseline_runs_keep_the_ratio_of_their_own_run(self):
+        # Two baseline runs, the second on a machine 40 % slower for Embree and
+        # ours alike: pooled, every repetition keeps its own run's ratio, so an
+        # unchanged current passes and a 20 % drop reads as exactly 20 %.
+        def everything_slower(row):
+            row["mrays_s_samples"] = ";".join(f"{float(v) * 0.6:.6g}" for v in row["mrays_s_samples"].split(";"))
+        def slower(row):
+            if row["backend"] == "bvh2" and row["rayset"] == "primary":
+                row["mrays_s_samples"] = ";".join(f"{float(v) * 0.8:.6g}" for v in row["mrays_s_samples"].split(";"))
+        slow_base = self.doctored("slow_base", everything_slower)
+        pooled = ("gate", "--baseline", self.baseline, "--baseline", slow_base)
+        same = run(*pooled, "--current", self.doctored("same3", lambda row: None))
+        self.assertEqual(same.returncode, 0, same.stdout + same.stderr)
+        self.assertIn(f"against {self.baseline} + {slow_base}", same.stdout)
+        drop = run(*pooled, "--current", self.doctored("drop3", slower))
+        self.assertEqual(drop.returncode, 1, drop.stdout + drop.stderr)
+        self.assertIn("FAIL: terrain/primary/bvh2/threads:1: ratio to Embree fell 20.0%", drop.stdout)
+
     def test_a_slow_machine_does_not_fail_when_ratios_hold(self):
         def everything_slower(row):
             row["mrays_s_samples"] = ";".join(f"{float(v) * 0.6:.6g}" for v in row["mrays_s_samples"].split(";"))
