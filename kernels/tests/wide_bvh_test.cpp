@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -30,12 +31,12 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 
 class WideBvhBuild : public ::testing::TestWithParam<Bvh2Builder> {
  protected:
-  // As the bvh8 and bvh4 backends build them: leaves of at most W triangles,
-  // and the SAH counts leaf tests in packs of W.
+  // As the bvh8 and bvh4 backends build them: BVH2 leaves of at most W
+  // triangles, scored as scalar tests, gathered into packs by the collapse.
   template <int W = 8>
   WideBvh<W> build(const std::vector<Triangle>& tris) const {
     Bvh2BuildOptions options;
-    options.leaf_granularity = W;
+    options.leaf_granularity = 1;
     options.max_leaf_size = W;
     return collapse_bvh2<W>(build_bvh2(tris, GetParam(), options), tris);
   }
@@ -303,6 +304,84 @@ TEST_P(WideBvhBuild, SahCostCountsNodeVisitsAndPackTests) {
     EXPECT_TRUE(std::isfinite(cost));
     EXPECT_GT(cost, 1.0);
     EXPECT_EQ(build<width()>({}).sah_cost(), 0.0);
+  });
+}
+
+// The least SAH cost (as WideBvh::sah_cost, times the root's area) of any wide
+// tree whose nodes are cuts of `bvh2`, by trying every cut: independent of
+// the collapse's dynamic programme, and exponential, so for small trees only.
+class ExhaustiveCollapse {
+ public:
+  ExhaustiveCollapse(const Bvh2& bvh2, std::size_t width) : bvh2_(bvh2), width_(width) {}
+
+  // The root is always a wide node.
+  double least_cost() { return as_node(0); }
+
+ private:
+  using Cut = std::vector<std::uint32_t>;
+
+  std::uint32_t triangles(std::uint32_t n) const {
+    const Bvh2Node& node = bvh2_.nodes[n];
+    return node.is_leaf() ? node.prim_count : triangles(node.first_index) + triangles(node.first_index + 1);
+  }
+  // Every set of at most width_ nodes below or at n that holds each of its leaves once.
+  std::vector<Cut> cuts(std::uint32_t n) const {
+    std::vector<Cut> out{{n}};
+    if (!bvh2_.nodes[n].is_leaf()) {
+      for (const Cut& left : cuts(bvh2_.nodes[n].first_index))
+        for (const Cut& right : cuts(bvh2_.nodes[n].first_index + 1))
+          if (left.size() + right.size() <= width_) {
+            Cut both = left;
+            both.insert(both.end(), right.begin(), right.end());
+            out.push_back(both);
+          }
+    }
+    return out;
+  }
+  double area(std::uint32_t n) const { return bvh2_.nodes[n].bounds.half_area(); }
+  // n in one child slot: a pack of its triangles, or a wide node.
+  double in_one_slot(std::uint32_t n) {
+    const double pack = triangles(n) <= width_ ? area(n) : std::numeric_limits<double>::infinity();
+    return bvh2_.nodes[n].is_leaf() ? pack : std::min(pack, as_node(n));
+  }
+  // n as a wide node: its visit, then its children, the best cut below it.
+  double as_node(std::uint32_t n) {
+    if (const auto it = node_cost_.find(n); it != node_cost_.end()) return it->second;
+    double best = std::numeric_limits<double>::infinity();
+    for (const Cut& left : cuts(bvh2_.nodes[n].first_index))
+      for (const Cut& right : cuts(bvh2_.nodes[n].first_index + 1)) {
+        if (left.size() + right.size() > width_) continue;
+        double cost = 0.0;
+        for (std::uint32_t c : left) cost += in_one_slot(c);
+        for (std::uint32_t c : right) cost += in_one_slot(c);
+        best = std::min(best, cost);
+      }
+    return node_cost_[n] = area(n) + best;
+  }
+
+  const Bvh2& bvh2_;
+  std::size_t width_;
+  std::map<std::uint32_t, double> node_cost_;
+};
+
+TEST_P(WideBvhBuild, TheCollapseHasTheLeastSahCostOfAnyWideTreeCutFromTheBvh2) {
+  for_each_width([&](auto width) {
+    constexpr int W = width();
+    for (std::size_t n : {2u, 5u, 9u, 13u, 18u}) {
+      for (std::uint64_t seed : {1u, 2u, 3u}) {
+        const auto tris = random_soup(n, seed);
+        for (int granularity : {1, W}) {  // small BVH2 leaves, and leaves of up to W
+          Bvh2BuildOptions options;
+          options.leaf_granularity = granularity;
+          options.max_leaf_size = W;
+          const Bvh2 bvh2 = build_bvh2(tris, GetParam(), options);
+          if (bvh2.nodes[0].is_leaf()) continue;  // nothing to choose
+          const double least = ExhaustiveCollapse(bvh2, W).least_cost() / bvh2.nodes[0].bounds.half_area();
+          EXPECT_NEAR(collapse_bvh2<W>(bvh2, tris).sah_cost(), least, 1e-5 * least)
+              << n << " triangles, seed " << seed << ", granularity " << granularity << ", width " << W;
+        }
+      }
+    }
   });
 }
 

@@ -35,8 +35,11 @@ class WideBvhBackend final : public Backend {
 
   void build(const Scene& scene) override {
     Bvh2BuildOptions options;
-    options.leaf_granularity = W;  // leaves are tested W triangles at once
-    options.max_leaf_size = W;     // and hold at most one pack
+    // Small BVH2 leaves, scored as scalar tests: the collapse gathers subtrees
+    // of up to W triangles into packs where the wide tree's SAH says so
+    // (wide_bvh_collapse.cpp), which fills nodes better than full BVH2 leaves.
+    options.leaf_granularity = 1;
+    options.max_leaf_size = W;  // a BVH2 leaf fits one pack
     options.reinsertion_passes = reinsertion_passes_;
     bvh_ = collapse_bvh2<W>(build_bvh2(scene.triangles, builder_, options), scene.triangles, Leaf::kLeaves);
   }

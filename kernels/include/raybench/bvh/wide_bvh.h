@@ -2,9 +2,10 @@
 // Each node holds its W children's bounds structure-of-arrays (BBoxWide), so
 // one SIMD slab test visits all of them; leaves are TrianglePack<W>s of up to
 // W triangles, tested at once.
-// The collapse is the usual greedy one (Wald et al., "Getting Rid of Packets",
-// RT 2008; Embree's BVH8 from BVH2): open the child with the largest surface
-// area until W children or only leaves remain.
+// The collapse chooses, among all wide trees whose nodes are cuts of the
+// BVH2, the one of least SAH cost (sah_cost below), by the dynamic programme
+// of Ylitie, Karras & Laine (HPG 2017); any BVH2 subtree of at most W
+// triangles may become a pack.
 // Each node also stores, for each of the 8 direction octants, an order of its
 // children from far to near along that octant's diagonal (by box centre), so
 // traversal orders the children it enters with one permutation instead of
@@ -89,7 +90,8 @@ using Bvh8 = WideBvh<8>;
 using Bvh4 = WideBvh<4>;
 
 // Collapses `bvh2` (whose leaves hold at most W triangles, as every builder
-// of bvh2_builders.h makes them with max_leaf_size W) over `triangles`.
+// of bvh2_builders.h makes them with max_leaf_size W) over `triangles`, into
+// the wide tree of least sah_cost() among those whose nodes are cuts of it.
 // WideLeaves::kVertices needs W = 8 (std::invalid_argument otherwise).
 template <int W>
 WideBvh<W> collapse_bvh2(const Bvh2& bvh2, std::span<const Triangle> triangles,
