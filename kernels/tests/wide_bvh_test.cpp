@@ -31,8 +31,9 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 
 class WideBvhBuild : public ::testing::TestWithParam<Bvh2Builder> {
  protected:
-  // As the bvh8 and bvh4 backends build them: BVH2 leaves of at most W
-  // triangles, scored as scalar tests, gathered into packs by the collapse.
+  // As the backends' quality builds (sbvh, reinsert) make them: BVH2 leaves
+  // of at most W triangles, scored as scalar tests, gathered into packs by
+  // the collapse. The watertight tests below build as the default does.
   template <int W = 8>
   WideBvh<W> build(const std::vector<Triangle>& tris) const {
     Bvh2BuildOptions options;
