@@ -32,12 +32,17 @@ raybench_install_packages() {
   fi
 }
 
+# raybench_build [SOURCE BUILD [cmake options]]: configures (once) and builds
+# Release; this checkout into $RAYBENCH_BUILD_DIR without arguments.
 raybench_build() {
+  src=${1:-$RAYBENCH_ROOT}
+  dir=${2:-$RAYBENCH_BUILD_DIR}
+  if [ $# -ge 2 ]; then shift 2; else set --; fi
   jobs=$(nproc 2>/dev/null || echo 2)
-  if [ ! -f "$RAYBENCH_BUILD_DIR/build.ninja" ]; then
-    cmake -S "$RAYBENCH_ROOT" -B "$RAYBENCH_BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release >&2
+  if [ ! -f "$dir/build.ninja" ]; then
+    cmake -S "$src" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "$@" >&2
   fi
-  cmake --build "$RAYBENCH_BUILD_DIR" -j "$jobs" >&2
+  cmake --build "$dir" -j "$jobs" >&2
 }
 
 raybench_install_packages
