@@ -1,11 +1,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include "raybench/bvh/wide_bvh.h"
 
@@ -45,12 +47,13 @@ void order_children(WideNode<W>& node) {
   }
 }
 
-// The collapse in two passes. The first, serial and cheap, decides the wide
-// tree's shape from the BVH2 alone: which BVH2 nodes become each wide node's
-// children, which of those are packs, and the index of every wide node and
-// pack, in depth-first order. The second fills nodes and packs, which costs
-// most (boxes, child orders, triangle packs), in parallel: each writes only
-// its own slot, so the result is the same for any thread count.
+// The collapse in two passes. The first decides the wide tree's shape from
+// the BVH2 alone: which BVH2 nodes become each wide node's children, which of
+// those are packs (the costs below, in parallel tasks), and the index of
+// every wide node and pack, in depth-first order (serial, cheap). The second
+// fills nodes and packs, which costs most (boxes, child orders, triangle
+// packs), in parallel: each writes only its own slot, so the result is the
+// same for any thread count.
 //
 // The shape is the one of least SAH cost (WideBvh::sah_cost: a node visit
 // and a pack test cost 1 each, weighted by the area of the box leading to
@@ -114,70 +117,69 @@ class Collapser {
     bool as_pack = false;   // in one slot: a pack (or else a wide node)
   };
 
-  // Bottom-up over the BVH2 (children before parents: reversed preorder).
   void choose_slots() {
-    const std::size_t n2 = bvh2_.nodes.size();
-    slots_.assign(n2, Slots{});
-    std::vector<float> cost(n2 * W);  // cost[n * W + k - 1]: subtree n in at most k slots
-    std::vector<std::uint32_t> triangles(n2, 0);
-    std::vector<std::uint32_t> preorder;
-    preorder.reserve(n2);
-    std::vector<std::uint32_t> todo{0};
-    while (!todo.empty()) {
-      const std::uint32_t n = todo.back();
-      todo.pop_back();
-      preorder.push_back(n);
-      if (!bvh2_.nodes[n].is_leaf()) {
-        todo.push_back(bvh2_.nodes[n].first_index);
-        todo.push_back(bvh2_.nodes[n].first_index + 1);
-      }
-    }
+    slots_.resize(bvh2_.nodes.size());
+    cost_ = std::make_unique_for_overwrite<float[]>(bvh2_.nodes.size() * W);
+    choose_slots_below(0, 0);
+  }
+
+  // Fills slots_ and cost_ for the BVH2 subtree at `n`, children before
+  // their parent; returns the subtree's triangle count. The top levels'
+  // subtrees are evaluated as parallel tasks: each node writes only its own
+  // entries, so the result is the same for any thread count.
+  std::uint32_t choose_slots_below(std::uint32_t n, int depth) {
     constexpr float kInf = std::numeric_limits<float>::infinity();
-    for (auto it = preorder.rbegin(); it != preorder.rend(); ++it) {
-      const std::uint32_t n = *it;
-      const Bvh2Node& node = bvh2_.nodes[n];
-      const float area = node.bounds.half_area();
-      float* g = &cost[n * W];
-      Slots& s = slots_[n];
-      std::fill(s.left, s.left + W, std::int8_t{0});
-      if (node.is_leaf()) {
-        expect_fits_a_pack(node);
-        triangles[n] = node.prim_count;
-        s.as_pack = true;
-        std::fill(g, g + W, area);
-        continue;
-      }
-      const std::uint32_t l = node.first_index, r = l + 1;
-      triangles[n] = triangles[l] + triangles[r];
-      const float* gl = &cost[l * W];
-      const float* gr = &cost[r * W];
-      // split[k - 1]: the cheapest sharing of k >= 2 slots between the children.
-      float split[W];
-      std::int8_t split_left[W] = {};
-      for (int k = 2; k <= W; ++k) {
-        split[k - 1] = kInf;
-        for (int i = 1; i < k; ++i) {
-          const float c = gl[i - 1] + gr[k - i - 1];
-          if (c < split[k - 1]) {
-            split[k - 1] = c;
-            split_left[k - 1] = static_cast<std::int8_t>(i);
-          }
-        }
-      }
-      const float as_node = area + split[W - 1];
-      const float as_pack = triangles[n] <= W ? area : kInf;
-      s.as_pack = as_pack <= as_node;
-      s.as_node_left = split_left[W - 1];
-      const float one_slot = std::min(as_pack, as_node);
-      g[0] = one_slot;
-      for (int k = 2; k <= W; ++k) {
-        g[k - 1] = one_slot;
-        if (split[k - 1] < one_slot) {
-          g[k - 1] = split[k - 1];
-          s.left[k - 1] = split_left[k - 1];
+    const Bvh2Node& node = bvh2_.nodes[n];
+    const float area = node.bounds.half_area();
+    float* g = &cost_[n * W];  // g[k - 1]: the subtree in at most k slots
+    Slots& s = slots_[n];
+    std::fill(s.left, s.left + W, std::int8_t{0});
+    if (node.is_leaf()) {
+      expect_fits_a_pack(node);
+      s.as_pack = true;
+      std::fill(g, g + W, area);
+      return node.prim_count;
+    }
+    const std::uint32_t l = node.first_index, r = l + 1;
+    std::uint32_t left_triangles = 0, right_triangles = 0;
+    const auto left = [&] { left_triangles = choose_slots_below(l, depth + 1); };
+    const auto right = [&] { right_triangles = choose_slots_below(r, depth + 1); };
+    if (depth < kParallelDepth) {
+      tbb::parallel_invoke(left, right);
+    } else {
+      left();
+      right();
+    }
+    const std::uint32_t triangles = left_triangles + right_triangles;
+    const float* gl = &cost_[l * W];
+    const float* gr = &cost_[r * W];
+    // split[k - 1]: the cheapest sharing of k >= 2 slots between the children.
+    float split[W];
+    std::int8_t split_left[W] = {};
+    for (int k = 2; k <= W; ++k) {
+      split[k - 1] = kInf;
+      for (int i = 1; i < k; ++i) {
+        const float c = gl[i - 1] + gr[k - i - 1];
+        if (c < split[k - 1]) {
+          split[k - 1] = c;
+          split_left[k - 1] = static_cast<std::int8_t>(i);
         }
       }
     }
+    const float as_node = area + split[W - 1];
+    const float as_pack = triangles <= W ? area : kInf;
+    s.as_pack = as_pack <= as_node;
+    s.as_node_left = split_left[W - 1];
+    const float one_slot = std::min(as_pack, as_node);
+    g[0] = one_slot;
+    for (int k = 2; k <= W; ++k) {
+      g[k - 1] = one_slot;
+      if (split[k - 1] < one_slot) {
+        g[k - 1] = split[k - 1];
+        s.left[k - 1] = split_left[k - 1];
+      }
+    }
+    return triangles;
   }
 
   // Appends the children chosen for the BVH2 subtree at `n` given `k` slots.
@@ -218,7 +220,9 @@ class Collapser {
     const Plan& p = plans_[i];
     BBox boxes[W];
     for (int k = 0; k < p.count; ++k) boxes[k] = bvh2_.nodes[p.kids[k]].bounds;
-    WideNode<W>& node = out_.nodes[i];
+    // Value-initialised first: its padding (W = 4) is zeroed, so equal trees
+    // are equal bytes (the nodes array is allocated unwritten).
+    WideNode<W>& node = *std::construct_at(&out_.nodes[i]);
     node.bounds = BBoxWide<W>::pack({boxes, static_cast<std::size_t>(p.count)});
     std::fill(node.child, node.child + W, WideBvh<W>::kEmptyChild);
     std::copy(p.child, p.child + p.count, node.child);
@@ -259,7 +263,11 @@ class Collapser {
   WideLeaves leaves_;
   WideBvh<W>& out_;
   std::vector<Plan> plans_;
+  // BVH2 levels above this many are evaluated as parallel tasks (at most
+  // 2^kParallelDepth tasks).
+  static constexpr int kParallelDepth = 7;
   std::vector<Slots> slots_;                // per BVH2 node
+  std::unique_ptr<float[]> cost_;           // per BVH2 node, W entries: its subtree in at most 1..W slots
   std::vector<std::uint32_t> pack_roots_;  // the BVH2 subtree of each pack
 };
 

@@ -12,6 +12,8 @@
 #include <cstddef>
 #include <cstdlib>
 #include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #if defined(__linux__)
@@ -42,7 +44,7 @@ inline void free_huge_pages(void* p, std::size_t bytes, std::size_t alignment) {
 }
 
 // A standard allocator over allocate_huge_pages, for the std::vectors of a
-// BVH (WideBvh's nodes and packs).
+// BVH (WideBvh's nodes and packs), whose elements it default-initialises.
 template <typename T>
 struct HugePageAllocator {
   using value_type = T;
@@ -53,6 +55,18 @@ struct HugePageAllocator {
 
   T* allocate(std::size_t n) { return static_cast<T*>(allocate_huge_pages(n * sizeof(T), alignof(T))); }
   void deallocate(T* p, std::size_t n) noexcept { free_huge_pages(p, n * sizeof(T), alignof(T)); }
+
+  // resize(n) default-initialises: trivial elements (nodes, packs) are left
+  // unwritten, for the collapse to fill in parallel. Value-initialising them
+  // would first zero the whole array serially, and touch every page there.
+  template <typename U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
 
   template <typename U>
   bool operator==(const HugePageAllocator<U>&) const noexcept {
