@@ -216,16 +216,34 @@ class Collapser {
     return index;
   }
 
+  // The node's lanes hold its children by decreasing box area (ties in the
+  // plan's order): any-hit traversal pushes them in lane order, so it pops
+  // the smallest first (wide_bvh_traverse.h says why).
   void fill_node(std::size_t i) {
     const Plan& p = plans_[i];
     BBox boxes[W];
-    for (int k = 0; k < p.count; ++k) boxes[k] = bvh2_.nodes[p.kids[k]].bounds;
+    std::uint32_t child[W];
+    float area[W];
+    for (int k = 0; k < p.count; ++k) {
+      const BBox& box = bvh2_.nodes[p.kids[k]].bounds;
+      float a = box.half_area();
+      if (std::isnan(a)) a = -std::numeric_limits<float>::infinity();  // a strict weak order even for a NaN box
+      int at = k;  // a stable insertion sort of at most W
+      for (; at > 0 && area[at - 1] < a; --at) {
+        boxes[at] = boxes[at - 1];
+        child[at] = child[at - 1];
+        area[at] = area[at - 1];
+      }
+      boxes[at] = box;
+      child[at] = p.child[k];
+      area[at] = a;
+    }
     // Value-initialised first: its padding (W = 4) is zeroed, so equal trees
     // are equal bytes (the nodes array is allocated unwritten).
     WideNode<W>& node = *std::construct_at(&out_.nodes[i]);
     node.bounds = BBoxWide<W>::pack({boxes, static_cast<std::size_t>(p.count)});
     std::fill(node.child, node.child + W, WideBvh<W>::kEmptyChild);
-    std::copy(p.child, p.child + p.count, node.child);
+    std::copy(child, child + p.count, node.child);
     order_children(node);
   }
 

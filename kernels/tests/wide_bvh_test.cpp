@@ -386,6 +386,26 @@ TEST_P(WideBvhBuild, TheCollapseHasTheLeastSahCostOfAnyWideTreeCutFromTheBvh2) {
   });
 }
 
+TEST_P(WideBvhBuild, EveryNodeHoldsItsChildrenByDecreasingBoxAreaEmptyLanesLast) {
+  // The any-hit traversal pops the smallest child first (wide_bvh_traverse.h).
+  const auto tris = random_soup(5000, 4);
+  for_each_width([&](auto width) {
+  constexpr int W = width();
+  const auto bvh = build<W>(tris);
+  std::size_t unequal_neighbours = 0;
+  for (const WideNode<W>& node : bvh.nodes) {
+    for (int lane = 1; lane < W; ++lane) {
+      if (node.child[lane] == WideBvh<W>::kEmptyChild) continue;
+      ASSERT_NE(node.child[lane - 1], WideBvh<W>::kEmptyChild) << "a child after an empty lane";
+      const float before = node.bounds.lane(lane - 1).half_area(), here = node.bounds.lane(lane).half_area();
+      EXPECT_GE(before, here) << "lane " << lane;
+      unequal_neighbours += before != here;
+    }
+  }
+  EXPECT_GT(unequal_neighbours, bvh.nodes.size());  // the order is not vacuous
+  });
+}
+
 TEST_P(WideBvhBuild, EveryNodeOrdersItsChildrenFarToNearAlongEachOctantsDiagonal) {
   const auto tris = random_soup(5000, 4);
   for_each_width([&](auto width) {

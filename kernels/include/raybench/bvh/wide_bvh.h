@@ -36,7 +36,9 @@ struct alignas(64) WideNode {
   using Order = std::conditional_t<W == 8, std::uint32_t, std::uint8_t>;
 
   BBoxWide<W> bounds;       // empty boxes in unused lanes: no ray enters them
-  std::uint32_t child[W];   // kEmptyChild, an inner node index, or kLeafBit | pack index
+  // kEmptyChild, an inner node index, or kLeafBit | pack index; by decreasing
+  // box area, empty lanes last (the any-hit traversal's order).
+  std::uint32_t child[W];
   // far_to_near[octant]: the W lanes, kOrderBits each, lowest bits first, from
   // the child farthest along the octant's diagonal to the nearest. The octant
   // of a direction is bit a set when its slab test enters axis a by the upper
