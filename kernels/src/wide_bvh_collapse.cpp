@@ -70,8 +70,9 @@ void order_children(WideNode<W>& node) {
 template <int W>
 class Collapser {
  public:
-  Collapser(const Bvh2& bvh2, std::span<const Triangle> triangles, WideLeaves leaves, WideBvh<W>& out)
-      : bvh2_(bvh2), triangles_(triangles), leaves_(leaves), out_(out) {}
+  Collapser(const Bvh2& bvh2, std::span<const Triangle> triangles, WideLeaves leaves, WideLaneOrder lane_order,
+            WideBvh<W>& out)
+      : bvh2_(bvh2), triangles_(triangles), leaves_(leaves), lane_order_(lane_order), out_(out) {}
 
   void run() {
     const Bvh2Node& root = bvh2_.nodes[0];
@@ -216,9 +217,10 @@ class Collapser {
     return index;
   }
 
-  // The node's lanes hold its children by decreasing box area (ties in the
-  // plan's order): any-hit traversal pushes them in lane order, so it pops
-  // the smallest first (wide_bvh_traverse.h says why).
+  // With WideLaneOrder::kByArea the node's lanes hold its children by
+  // decreasing box area (ties in the plan's order, the BVH2's): any-hit
+  // traversal pushes them in lane order, so it pops the smallest first
+  // (wide_bvh_traverse.h says why).
   void fill_node(std::size_t i) {
     const Plan& p = plans_[i];
     BBox boxes[W];
@@ -229,7 +231,7 @@ class Collapser {
       float a = box.half_area();
       if (std::isnan(a)) a = -std::numeric_limits<float>::infinity();  // a strict weak order even for a NaN box
       int at = k;  // a stable insertion sort of at most W
-      for (; at > 0 && area[at - 1] < a; --at) {
+      for (; lane_order_ == WideLaneOrder::kByArea && at > 0 && area[at - 1] < a; --at) {
         boxes[at] = boxes[at - 1];
         child[at] = child[at - 1];
         area[at] = area[at - 1];
@@ -279,6 +281,7 @@ class Collapser {
   const Bvh2& bvh2_;
   std::span<const Triangle> triangles_;
   WideLeaves leaves_;
+  WideLaneOrder lane_order_;
   WideBvh<W>& out_;
   std::vector<Plan> plans_;
   // BVH2 levels above this many are evaluated as parallel tasks (at most
@@ -292,12 +295,13 @@ class Collapser {
 }  // namespace
 
 template <int W>
-WideBvh<W> collapse_bvh2(const Bvh2& bvh2, std::span<const Triangle> triangles, WideLeaves leaves) {
+WideBvh<W> collapse_bvh2(const Bvh2& bvh2, std::span<const Triangle> triangles, WideLeaves leaves,
+                         WideLaneOrder lane_order) {
   if (W != 8 && leaves == WideLeaves::kVertices)
     throw std::invalid_argument("collapse_bvh2: vertex leaves (the watertight test) are 8 wide only");
   WideBvh<W> out;
   if (triangles.empty()) return out;  // no nodes: traversal returns at once
-  Collapser<W>(bvh2, triangles, leaves, out).run();
+  Collapser<W>(bvh2, triangles, leaves, lane_order, out).run();
   return out;
 }
 
@@ -317,7 +321,7 @@ double WideBvh<W>::sah_cost() const {
 
 template struct WideBvh<4>;
 template struct WideBvh<8>;
-template WideBvh<4> collapse_bvh2<4>(const Bvh2&, std::span<const Triangle>, WideLeaves);
-template WideBvh<8> collapse_bvh2<8>(const Bvh2&, std::span<const Triangle>, WideLeaves);
+template WideBvh<4> collapse_bvh2<4>(const Bvh2&, std::span<const Triangle>, WideLeaves, WideLaneOrder);
+template WideBvh<8> collapse_bvh2<8>(const Bvh2&, std::span<const Triangle>, WideLeaves, WideLaneOrder);
 
 }  // namespace raybench

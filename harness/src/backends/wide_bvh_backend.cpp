@@ -46,7 +46,13 @@ class WideBvhBackend final : public Backend {
     options.leaf_granularity = quality ? 1 : W;
     options.max_leaf_size = W;  // a BVH2 leaf fits one pack
     options.reinsertion_passes = reinsertion_passes_;
-    bvh_ = collapse_bvh2<W>(build_bvh2(scene.triangles, builder_, options), scene.triangles, Leaf::kLeaves);
+    // Any-hit traversal visits the children in lane order: the smallest box
+    // first for the default build, the BVH2's order for the quality builds.
+    // Measured on shadow rays, one thread, interleaved: smallest first made
+    // the default build 1.21x faster on Sponza, 1.01x on Conference, but
+    // bvh8:reinsert 0.89x and 0.93x, bvh8:sbvh:reinsert 1.01x and 0.97x.
+    const WideLaneOrder lanes = quality ? WideLaneOrder::kBvh2 : WideLaneOrder::kByArea;
+    bvh_ = collapse_bvh2<W>(build_bvh2(scene.triangles, builder_, options), scene.triangles, Leaf::kLeaves, lanes);
   }
 
   std::size_t memory_bytes() const override { return bvh_.memory_bytes(); }

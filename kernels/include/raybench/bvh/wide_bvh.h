@@ -36,8 +36,8 @@ struct alignas(64) WideNode {
   using Order = std::conditional_t<W == 8, std::uint32_t, std::uint8_t>;
 
   BBoxWide<W> bounds;       // empty boxes in unused lanes: no ray enters them
-  // kEmptyChild, an inner node index, or kLeafBit | pack index; by decreasing
-  // box area, empty lanes last (the any-hit traversal's order).
+  // kEmptyChild, an inner node index, or kLeafBit | pack index, in the
+  // collapse's WideLaneOrder, empty lanes last (the any-hit traversal's order).
   std::uint32_t child[W];
   // far_to_near[octant]: the W lanes, kOrderBits each, lowest bits first, from
   // the child farthest along the octant's diagonal to the nearest. The octant
@@ -65,6 +65,11 @@ inline int far_to_near_lane(const WideNode<W>& node, int octant, int rank) {
 // 8-wide only: the edges must not be rounded, or shared edges would no
 // longer match).
 enum class WideLeaves { kMollerTrumbore, kVertices };
+
+// The order of a node's children in its lanes, which is the order any-hit
+// traversal visits them in (wide_bvh_traverse.h): by decreasing box area
+// (the smallest popped first), or the BVH2's own order (left before right).
+enum class WideLaneOrder { kByArea, kBvh2 };
 
 template <int W>
 struct WideBvh {
@@ -97,6 +102,7 @@ using Bvh4 = WideBvh<4>;
 // WideLeaves::kVertices needs W = 8 (std::invalid_argument otherwise).
 template <int W>
 WideBvh<W> collapse_bvh2(const Bvh2& bvh2, std::span<const Triangle> triangles,
-                         WideLeaves leaves = WideLeaves::kMollerTrumbore);
+                         WideLeaves leaves = WideLeaves::kMollerTrumbore,
+                         WideLaneOrder lane_order = WideLaneOrder::kByArea);
 
 }  // namespace raybench

@@ -9,18 +9,22 @@
 // Any hit (shadow rays) returns at the first hit in the interval and orders
 // nothing per ray: the children entered are pushed in the node's lane order,
 // ref only (its interval never shrinks, so no entry distance is needed), as
-// Embree's any-hit traversal does. The collapse puts the children in the
-// lanes by decreasing box area, so the smallest is popped first: small boxes
-// are mostly full of geometry, large ones mostly empty space (the
-// probability of occlusion per cost, Ize & Hansen, "RTSAH Traversal Order
-// for Occlusion Rays", EG 2011, which smallest-first approximates). Measured
-// on the default suite's shadow rays, one thread, same tree otherwise,
-// against the BVH2's order: Sponza 1.28x, Sponza-Dabrovic 1.04x, Sibenik
-// 1.03x, Conference 1.02x, bunny 1.02x, Lucy 0.99x. Cheapest subtree first
-// (by expected SAH cost) was better on Sponza-Dabrovic (1.04x) but worse on
-// Sponza (0.84x) and Lucy (0.93x); leaves first, worse everywhere. Nearest first (the octant order) was 1.15x on Sponza but 0.89-0.93x
-// on Lucy, bunny and Conference: it mostly visits the surface around the
-// ray's origin, which a shadow ray leaves without hitting.
+// Embree's any-hit traversal does. With WideLaneOrder::kByArea (the
+// backends' default build) the collapse puts the children in the lanes by
+// decreasing box area, so the smallest is popped first: small boxes are
+// mostly full of geometry, large ones mostly empty space (the probability
+// of occlusion per cost, Ize & Hansen, "RTSAH Traversal Order for Occlusion
+// Rays", EG 2011, which smallest-first approximates). Measured on the
+// default suite's shadow rays, one thread, default build, against the
+// BVH2's order: Sponza 1.21-1.28x, Sponza-Dabrovic 1.04x, Sibenik 1.03x,
+// Conference 1.01-1.02x, bunny 1.02x, Lucy 0.99x. The quality builds keep
+// the BVH2's order, which measured better on their trees
+// (wide_bvh_backend.cpp). Cheapest subtree first (by expected SAH cost) was
+// better on Sponza-Dabrovic (1.04x) but worse on Sponza (0.84x) and Lucy
+// (0.93x); leaves first, worse everywhere. Nearest first (the octant order)
+// was 1.15x on Sponza but 0.89-0.93x on Lucy, bunny and Conference: it
+// mostly visits the surface around the ray's origin, which a shadow ray
+// leaves without hitting.
 // The leaf test and the box test are policies: WideMollerTrumbore, or
 // Bvh8Watertight (8 wide, needs WideLeaves::kVertices); SlabFma (the
 // backends' plain test: one fused multiply-add per plane, as Embree's),
