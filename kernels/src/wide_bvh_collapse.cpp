@@ -14,12 +14,23 @@
 namespace raybench {
 namespace {
 
+// The indices 0 .. count - 1 ordered by decreasing key, ties in index order:
+// a stable insertion sort, count being at most a node's width. The callers
+// map the keys of NaN boxes to an infinity, keeping the order strict weak.
+template <int W>
+void order_by_decreasing(const float (&key)[W], int count, int (&order)[W]) {
+  for (int i = 0; i < count; ++i) {
+    int at = i;
+    for (; at > 0 && key[order[at - 1]] < key[i]; --at) order[at] = order[at - 1];
+    order[at] = i;
+  }
+}
+
 // WideNode::far_to_near: for each octant, the lanes sorted by how far their
 // box centre lies along the octant's diagonal (+x+y+z for octant 0, -x for
 // bit 0 ...), farthest first; empty lanes go first, as no ray enters them
 // (so do NaN boxes of a broken mesh, which no ray enters either).
-// Ties keep lane order (a stable insertion sort of at most 8 lanes), so the
-// result depends only on the boxes.
+// Ties keep lane order, so the result depends only on the boxes.
 template <int W>
 void order_children(WideNode<W>& node) {
   for (int octant = 0; octant < 8; ++octant) {
@@ -33,13 +44,10 @@ void order_children(WideNode<W>& node) {
           const float centre2 = node.bounds.lower[a][lane] + node.bounds.upper[a][lane];
           along[lane] += (octant >> a & 1) ? -centre2 : centre2;
         }
-        // A NaN box must not break the sort's strict weak order.
         if (std::isnan(along[lane])) along[lane] = std::numeric_limits<float>::infinity();
       }
-      int at = lane;
-      for (; at > 0 && along[lanes[at - 1]] < along[lane]; --at) lanes[at] = lanes[at - 1];
-      lanes[at] = lane;
     }
+    order_by_decreasing(along, W, lanes);
     std::uint32_t order = 0;
     for (int rank = 0; rank < W; ++rank)
       order |= static_cast<std::uint32_t>(lanes[rank]) << (WideNode<W>::kOrderBits * rank);
@@ -223,22 +231,21 @@ class Collapser {
   // (wide_bvh_traverse.h says why).
   void fill_node(std::size_t i) {
     const Plan& p = plans_[i];
+    int order[W];  // order[lane]: the plan's child in that lane
+    for (int k = 0; k < p.count; ++k) order[k] = k;
+    if (lane_order_ == WideLaneOrder::kByArea) {
+      float area[W];
+      for (int k = 0; k < p.count; ++k) {
+        area[k] = bvh2_.nodes[p.kids[k]].bounds.half_area();
+        if (std::isnan(area[k])) area[k] = -std::numeric_limits<float>::infinity();
+      }
+      order_by_decreasing(area, p.count, order);
+    }
     BBox boxes[W];
     std::uint32_t child[W];
-    float area[W];
-    for (int k = 0; k < p.count; ++k) {
-      const BBox& box = bvh2_.nodes[p.kids[k]].bounds;
-      float a = box.half_area();
-      if (std::isnan(a)) a = -std::numeric_limits<float>::infinity();  // a strict weak order even for a NaN box
-      int at = k;  // a stable insertion sort of at most W
-      for (; lane_order_ == WideLaneOrder::kByArea && at > 0 && area[at - 1] < a; --at) {
-        boxes[at] = boxes[at - 1];
-        child[at] = child[at - 1];
-        area[at] = area[at - 1];
-      }
-      boxes[at] = box;
-      child[at] = p.child[k];
-      area[at] = a;
+    for (int lane = 0; lane < p.count; ++lane) {
+      boxes[lane] = bvh2_.nodes[p.kids[order[lane]]].bounds;
+      child[lane] = p.child[order[lane]];
     }
     // Value-initialised first: its padding (W = 4) is zeroed, so equal trees
     // are equal bytes (the nodes array is allocated unwritten).
