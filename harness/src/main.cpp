@@ -94,7 +94,7 @@ int run(int argc, char** argv) {
       ->delimiter(',');
   run_cmd->add_option("--threads,-t", run_threads, "Thread counts, e.g. 1,2 (default: 1)")->delimiter(',')->check(CLI::PositiveNumber);
   run_cmd->add_option("--reps", run_reps, "Timed repetitions per case; the median is reported (default: 5)")->check(CLI::PositiveNumber);
-  run_cmd->add_option("--build-reps", run_build_reps, "Timed builds per backend (default: 3)")->check(CLI::PositiveNumber);
+  run_cmd->add_option("--build-reps", run_build_reps, "Timed builds per backend, interleaved across backends after one untimed build each (default: 3)")->check(CLI::PositiveNumber);
   run_cmd->add_option("--seed", run_seed, "Ray generation seed (default: 1)");
   run_cmd->add_option("--min-time", run_min_time, "Minimum seconds per repetition (default: 0.05)")->check(CLI::PositiveNumber);
   run_cmd->add_option("--warmup", run_warmup, "Untimed warm-up seconds per case (default: 0.05)")->check(CLI::NonNegativeNumber);

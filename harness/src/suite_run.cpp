@@ -17,6 +17,7 @@
 #include "agreement.h"
 #include "atomic_file.h"
 #include "backend.h"
+#include "build_timing.h"
 #include "error.h"
 #include "gbench.h"
 #include "metadata.h"
@@ -183,14 +184,17 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
       }
       reference.reset();
 
+      std::vector<Backend*> built;
       for (const std::string& backend_name : settings.backends) {
-        std::unique_ptr<Backend> backend = make_backend(backend_name, {threads});
-        std::vector<double> build_ms;
-        for (int b = 0; b < std::max(1, settings.build_repetitions); ++b) {
-          const auto start = std::chrono::steady_clock::now();
-          executor.run([&] { backend->build(scene); });
-          build_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-        }
+        backends.push_back(make_backend(backend_name, {threads}));
+        built.push_back(backends.back().get());
+      }
+      const std::vector<std::vector<double>> build_times =
+          time_builds_interleaved(built, scene, executor, settings.build_repetitions);
+      for (std::size_t bi = 0; bi < built.size(); ++bi) {
+        const std::string& backend_name = settings.backends[bi];
+        const Backend* backend = built[bi];
+        const std::vector<double>& build_ms = build_times[bi];
         progress(fmt::format("  built {} ({} threads) in {:.1f} ms, {:.1f} MiB", backend_name, threads, median(build_ms),
                              backend->memory_bytes() / 1048576.0));
         for (std::size_t r = 0; r < raysets.size(); ++r) {
@@ -246,9 +250,8 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
           if (is_must_hit(rs.kind)) row.leaks = a.rays - a.hits;
           const std::string name =
               fmt::format("trace/{}/{}/{}/threads:{}", scene.name, row.rayset, backend_name, threads);
-          cases.push_back({name, row, accuracy, backend.get(), &executor, &rs});
+          cases.push_back({name, row, accuracy, backend, &executor, &rs});
         }
-        backends.push_back(std::move(backend));
       }
     }
 
