@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -153,7 +154,7 @@ class Collapser {
     std::uint32_t left_triangles = 0, right_triangles = 0;
     const auto left = [&] { left_triangles = choose_slots_below(l, depth + 1); };
     const auto right = [&] { right_triangles = choose_slots_below(r, depth + 1); };
-    if (depth < kParallelDepth) {
+    if (depth < parallel_depth_) {
       tbb::parallel_invoke(left, right);
     } else {
       left();
@@ -291,9 +292,14 @@ class Collapser {
   WideLaneOrder lane_order_;
   WideBvh<W>& out_;
   std::vector<Plan> plans_;
-  // BVH2 levels above this many are evaluated as parallel tasks (at most
-  // 2^kParallelDepth tasks).
-  static constexpr int kParallelDepth = 7;
+  // BVH2 levels above parallel_depth_ are evaluated as parallel tasks: at
+  // most 2^7 of them, in a balanced tree of kTaskNodes / 2 to kTaskNodes
+  // nodes each (or larger, past 2^7). Small trees stay serial: on the 3,732
+  // triangles of Wuson, tasks made the collapse slower on two threads than
+  // on one.
+  static constexpr std::size_t kTaskNodes = 2048;
+  const int parallel_depth_ =
+      std::min(7, static_cast<int>(std::bit_width(bvh2_.nodes.size() / kTaskNodes)));
   std::vector<Slots> slots_;                // per BVH2 node
   std::unique_ptr<float[]> cost_;           // per BVH2 node, W entries: its subtree in at most 1..W slots
   std::vector<std::uint32_t> pack_roots_;  // the BVH2 subtree of each pack

@@ -34,6 +34,7 @@ class Bvh2Backend final : public Backend {
   const std::string& name() const override { return name_; }
 
   void build(const Scene& scene) override {
+    bvh_ = {};  // the old tree freed first, as Embree releases its old scene first
     bvh_ = build_bvh2(scene.triangles, builder_, options_);
     prepared_.clear();
     prepared_.reserve(bvh_.prim_ids.size());

@@ -52,6 +52,7 @@ class WideBvhBackend final : public Backend {
     // the default build 1.21x faster on Sponza, 1.01x on Conference, but
     // bvh8:reinsert 0.89x and 0.93x, bvh8:sbvh:reinsert 1.01x and 0.97x.
     const WideLaneOrder lanes = quality ? WideLaneOrder::kBvh2 : WideLaneOrder::kByArea;
+    bvh_ = {};  // the old tree freed first, as Embree releases its old scene first
     bvh_ = collapse_bvh2<W>(build_bvh2(scene.triangles, builder_, options), scene.triangles, Leaf::kLeaves, lanes);
   }
 
