@@ -2,10 +2,10 @@
 // known answers worked by hand, mostly on the unit box [0,1]^3.
 //
 //   AllBoxTests    properties every variant has, the seed included
-//   FixedBoxTests  what Slab, SlabRobust and SlabFma do and the seed does not
+//   FixedBoxTests  what Slab, SlabRobust, SlabRobustRay and SlabFma do and the seed does not
 //   SlabSeed.KnownFailure_*   the seed note's bugs, pinned as documented behaviour
 //   Slab / SlabRobust         rounding: the unpadded test misses a box the exact
-//                             ray touches, the padded one never does
+//   / SlabRobustRay           ray touches, the padded ones never do
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -17,6 +17,7 @@
 #include "raybench/prim/aabb_slab.h"
 #include "raybench/prim/aabb_slab_fma.h"
 #include "raybench/prim/aabb_slab_robust.h"
+#include "raybench/prim/aabb_slab_robust_ray.h"
 #include "raybench/prim/aabb_slab_seed.h"
 
 namespace raybench {
@@ -70,7 +71,7 @@ template <typename Box>
 
 template <typename Box>
 class AllBoxTests : public ::testing::Test {};
-using AllBoxes = ::testing::Types<SlabSeed, Slab, SlabRobust, SlabFma>;
+using AllBoxes = ::testing::Types<SlabSeed, Slab, SlabRobust, SlabRobustRay, SlabFma>;
 TYPED_TEST_SUITE(AllBoxTests, AllBoxes);
 
 TYPED_TEST(AllBoxTests, ObliqueHitReportsEntryAndExit) {
@@ -273,7 +274,7 @@ TYPED_TEST(AllBoxTests, MissLeavesTheOutputUntouched) {
 
 template <typename Box>
 class FixedBoxTests : public ::testing::Test {};
-using FixedBoxes = ::testing::Types<Slab, SlabRobust, SlabFma>;
+using FixedBoxes = ::testing::Types<Slab, SlabRobust, SlabRobustRay, SlabFma>;
 TYPED_TEST_SUITE(FixedBoxTests, FixedBoxes);
 
 TYPED_TEST(FixedBoxTests, TnearClipsAndIsClosed) {
@@ -415,6 +416,50 @@ TEST(SlabRobust, PadsTheExitByEightUnitRoundoffsAndNoMore) {
   EXPECT_FALSE(hits<Slab>(ray({0, 0, 0.5f}, {1, 1, 0}), box({1, 2 + 0x1p-21f, 0}, {2, 3, 1})));
 }
 
+TEST(SlabRobustRay, HitsBoxTheUnpaddedTestMissesByRounding) {
+  BoxHit h;
+  ASSERT_TRUE(hits<SlabRobustRay>(kCornerGrazer, kUnit, &h));
+  EXPECT_EQ(h.t_entry, 1.0f);
+  EXPECT_GE(h.t_exit, 1.0f);
+}
+
+TEST(SlabRobustRay, ScalesTheFarPlanesReciprocalsAndTmaxByEightUnitRoundoffsAndNoMore) {
+  // Along +x through the unit box: the exit 2 * fl(1 * (1 + 2^-21)).
+  BoxHit h;
+  ASSERT_TRUE(hits<SlabRobustRay>(ray({-1, 0.5f, 0.5f}, {1, 0, 0}), kUnit, &h));
+  EXPECT_EQ(h.t_exit, 0x1.000008p+1f);
+  // The same near miss as SlabRobust's: a gap of 2^-21 is reported, 2^-19 not.
+  EXPECT_TRUE(hits<SlabRobustRay>(ray({0, 0, 0.5f}, {1, 1, 0}), box({1, 2 + 0x1p-21f, 0}, {2, 3, 1})));
+  EXPECT_FALSE(hits<SlabRobustRay>(ray({0, 0, 0.5f}, {1, 1, 0}), box({1, 2 + 0x1p-19f, 0}, {2, 3, 1})));
+  // tmax is padded too: a box entered at t = 1 is reported for tmax one ulp
+  // below 1, not for tmax 2^-18 below.
+  const Vec3f o{-1, 0.5f, 0.5f}, d{1, 0, 0};
+  EXPECT_FALSE(hits<Slab>(ray(o, d, 0.0f, 0x1.fffffep-1f), kUnit));
+  EXPECT_TRUE(hits<SlabRobustRay>(ray(o, d, 0.0f, 0x1.fffffep-1f), kUnit));
+  EXPECT_FALSE(hits<SlabRobustRay>(ray(o, d, 0.0f, 1.0f - 0x1p-18f), kUnit));
+}
+
+TEST(SlabRobustRay, WithANegativeTnearPadsEveryExitAsSlabRobust) {
+  // Scaling a negative far distance up would shorten it, so rays that start
+  // behind their origin take SlabRobust's padding: the same answers, bit for bit.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-4, 4);
+  int hits_seen = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3f p{u(rng), u(rng), u(rng)}, q{u(rng), u(rng), u(rng)};
+    const Ray r = ray({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, -std::fabs(u(rng)), std::fabs(u(rng)));
+    BoxHit a, b;
+    const bool hit = hits<SlabRobustRay>(r, box(min(p, q), max(p, q)), &a);
+    ASSERT_EQ(hit, hits<SlabRobust>(r, box(min(p, q), max(p, q)), &b)) << "ray " << i;
+    if (hit) {
+      EXPECT_EQ(a.t_entry, b.t_entry);
+      EXPECT_EQ(a.t_exit, b.t_exit);
+      ++hits_seen;
+    }
+  }
+  EXPECT_GT(hits_seen, 1000);
+}
+
 TEST(SlabRobust, NeverMissesRaysAimedExactlyAtEdgesAndCorners) {
   // EXTREMES.md G17. Boxes, origins and targets on the grid 2^-10 Z (boxes in
   // [-16,16]^3, origins in [-64,64]^3); the target is a box corner or a point
@@ -427,7 +472,7 @@ TEST(SlabRobust, NeverMissesRaysAimedExactlyAtEdgesAndCorners) {
                               static_cast<std::int32_t>(range * 1024)) / 1024.0f;
   };
   constexpr int kRays = 100000;
-  int slab_misses = 0, robust_misses = 0;
+  int slab_misses = 0, robust_misses = 0, robust_ray_misses = 0;
   for (int i = 0; i < kRays; ++i) {
     const Vec3f p{grid(16), grid(16), grid(16)}, q{grid(16), grid(16), grid(16)};
     const BBox b = box(min(p, q), max(p, q));
@@ -446,8 +491,10 @@ TEST(SlabRobust, NeverMissesRaysAimedExactlyAtEdgesAndCorners) {
     const Ray r = ray(o, d);
     slab_misses += !hits<Slab>(r, b);
     robust_misses += !hits<SlabRobust>(r, b);
+    robust_ray_misses += !hits<SlabRobustRay>(r, b);
   }
   EXPECT_EQ(robust_misses, 0);
+  EXPECT_EQ(robust_ray_misses, 0) << "SlabRobustRay, the padding folded into the ray";
   EXPECT_GT(slab_misses, kRays / 100);  // the set is hard: without padding > 1 % are lost
 }
 

@@ -230,6 +230,7 @@ TEST_P(WideBvhBuild, WatertightLeavesMatchTheScalarWatertightTestOnEveryRayKind)
     const std::vector<Ray> rays = testing::rays_at(tris, kind, 2000, seed++);
     expect_watertight_leaves_match_brute_force<Slab>(bvh, tris, rays);
     expect_watertight_leaves_match_brute_force<SlabRobust>(bvh, tris, rays);
+    expect_watertight_leaves_match_brute_force<SlabRobustRay>(bvh, tris, rays);
   }
 }
 
@@ -241,14 +242,17 @@ TEST_P(WideBvhBuild, WatertightRobustTraversalLeaksNoRayAimedAtEdgesAndVerticesF
   const Bvh8 bvh = collapse_bvh2<8>(build_bvh2(tris, GetParam(), options), tris, WideLeaves::kVertices);
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(-0.5f, 0.5f), s(0, 1);
-  int leaks = 0;
+  int leaks = 0, leaks_ray_padded = 0;
   for (int i = 0; i < 6000; ++i) {
     const Triangle& t = tris[static_cast<std::size_t>(i) * 7919 % tris.size()];
     const Vec3f target = i % 2 ? t.v1 : t.v0 + (t.v2 - t.v0) * s(rng);  // a vertex, or a float point of an edge
     const Vec3f org{u(rng), u(rng), u(rng)};
-    leaks += !intersect_wide<Bvh8Watertight, SlabRobust>(bvh, Ray{org, 0.0f, target - org, kInf}).hit();
+    const Ray ray{org, 0.0f, target - org, kInf};
+    leaks += !intersect_wide<Bvh8Watertight, SlabRobust>(bvh, ray).hit();
+    leaks_ray_padded += !intersect_wide<Bvh8Watertight, SlabRobustRay>(bvh, ray).hit();
   }
   EXPECT_EQ(leaks, 0);
+  EXPECT_EQ(leaks_ray_padded, 0);
 }
 
 TEST_P(WideBvhBuild, FindsTheClosedSphereFromInsideAndNothingOutsideIt) {

@@ -139,6 +139,8 @@ TEST(Box8, Avx2AnswersExactlyAsTheScalarSlabTest) { expect_boxes_simd_equals_sca
 TEST(Box8, Avx2AnswersExactlyAsTheScalarRobustSlabTest) { expect_boxes_simd_equals_scalar<SlabRobust, 8>(); }
 TEST(Box4, SseAnswersExactlyAsTheScalarSlabTest) { expect_boxes_simd_equals_scalar<Slab, 4>(); }
 TEST(Box4, SseAnswersExactlyAsTheScalarRobustSlabTest) { expect_boxes_simd_equals_scalar<SlabRobust, 4>(); }
+TEST(Box8, Avx2AnswersExactlyAsTheScalarRobustRaySlabTest) { expect_boxes_simd_equals_scalar<SlabRobustRay, 8>(); }
+TEST(Box4, SseAnswersExactlyAsTheScalarRobustRaySlabTest) { expect_boxes_simd_equals_scalar<SlabRobustRay, 4>(); }
 TEST(Box8, Avx2AnswersExactlyAsTheScalarFusedSlabTest) { expect_boxes_simd_equals_scalar<SlabFma, 8>(); }
 TEST(Box4, SseAnswersExactlyAsTheScalarFusedSlabTest) { expect_boxes_simd_equals_scalar<SlabFma, 4>(); }
 

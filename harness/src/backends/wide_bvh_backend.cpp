@@ -5,7 +5,8 @@
 //   a triangle test: mt (Möller–Trumbore in its stored-normal form,
 //     prim/triangle_mt_normal.h, simd/wide_triangle.h; the default)
 //     or, 8 wide only, watertight (Woop et al. 2013, simd/triangle8_watertight.h);
-//   robust: the conservative wide box test (Ize's padding), so that
+//   robust: the conservative wide box test (Ize's padding folded into the
+//     ray, prim/aabb_slab_robust_ray.h), so that
 //     bvh8:watertight:robust leaks no ray through the tree either; without
 //     it, SlabFma (prim/aabb_slab_fma.h: one fused multiply-add per plane);
 //   a builder from raybench/bvh/bvh2_builders.h ("bvh8:sweep", "bvh4:lbvh");
@@ -82,7 +83,7 @@ class WideBvhBackend final : public Backend {
 template <int W, typename Leaf>
 std::unique_ptr<Backend> make_with_box_test(const std::string& name, Bvh2Builder builder, int reinsertion_passes,
                                             bool robust) {
-  if (robust) return std::make_unique<WideBvhBackend<W, Leaf, SlabRobust>>(name, builder, reinsertion_passes);
+  if (robust) return std::make_unique<WideBvhBackend<W, Leaf, SlabRobustRay>>(name, builder, reinsertion_passes);
   return std::make_unique<WideBvhBackend<W, Leaf, SlabFma>>(name, builder, reinsertion_passes);
 }
 

@@ -28,8 +28,9 @@
 // The leaf test and the box test are policies: WideMollerTrumbore, or
 // Bvh8Watertight (8 wide, needs WideLeaves::kVertices); SlabFma (the
 // backends' plain test: one fused multiply-add per plane, as Embree's),
-// Slab, or SlabRobust (the conservative test: with the watertight leaves no
-// ray leaks through the tree, as bvh2:watertight:robust).
+// Slab, or a conservative test (with the watertight leaves no ray leaks
+// through the tree, as bvh2:watertight:robust): SlabRobust pads every exit,
+// SlabRobustRay folds the padding into the ray (the backends' choice).
 #pragma once
 
 #include <array>
@@ -141,15 +142,20 @@ inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
   // the others take Slab's, which is exact for them (aabb_slab_fma.h).
   if constexpr (std::is_same_v<BoxTest, SlabFma>)
     if (!SlabFma::fused(r)) return traverse_wide<AnyHit, Leaf, Slab>(bvh, ray);
+  // The padding folded into the ray holds for tnear >= 0 only
+  // (aabb_slab_robust_ray.h); other rays pad every exit.
+  if constexpr (std::is_same_v<BoxTest, SlabRobustRay>)
+    if (!SlabRobustRay::folds(r)) return traverse_wide<AnyHit, Leaf, SlabRobust>(bvh, ray);
   const int octant = ray_octant(r);
 #if defined(__AVX2__)
-  const RayLanes<W> ray_lanes = RayLanes<W>::from(r);
+  const RayLanes<W> ray_lanes = RayLanes<W>::template from<BoxTest>(r);
 #endif
   const typename Leaf::RayData leaf_ray = Leaf::precompute(ray);
   // A popped subtree farther than the current hit is skipped; the robust
   // test compares with the padded bound, so it never skips what it entered.
   const auto reachable = [](float entry, float tmax) {
-    if constexpr (std::is_same_v<BoxTest, SlabRobust>) return entry <= tmax + std::fabs(tmax) * SlabRobust::kPad;
+    if constexpr (std::is_same_v<BoxTest, SlabRobust> || std::is_same_v<BoxTest, SlabRobustRay>)
+      return entry <= SlabRobustRay::padded(tmax);
     else return entry <= tmax;
   };
   float tmax = ray.tfar;

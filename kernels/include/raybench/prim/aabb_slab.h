@@ -72,12 +72,17 @@ struct Slab {
   // The overlap of [tnear, tmax] with the three slab intervals, as computed:
   // empty when !(t_entry <= t_exit). Shared with SlabRobust, which pads it.
   RAYBENCH_INLINE static BoxHit clip(const Precomputed& r, const BBox& box, float tmax) {
+    return clip(r, r.inv_dir, box, tmax);
+  }
+  // As above with the far planes' distances scaled by far_inv_dir instead of
+  // 1/d (SlabRobustRay's reciprocals rounded outward).
+  RAYBENCH_INLINE static BoxHit clip(const Precomputed& r, const Vec3f& far_inv_dir, const BBox& box, float tmax) {
     float entry = r.tnear, exit = tmax;
     for (int axis = 0; axis < 3; ++axis) {
       const float near_plane = r.negative[axis] ? box.upper[axis] : box.lower[axis];
       const float far_plane = r.negative[axis] ? box.lower[axis] : box.upper[axis];
       const float t_near = (near_plane - r.org[axis]) * r.inv_dir[axis];
-      const float t_far = (far_plane - r.org[axis]) * r.inv_dir[axis];
+      const float t_far = (far_plane - r.org[axis]) * far_inv_dir[axis];
       // Written so that a NaN distance (origin on the plane, zero component)
       // is ignored and a NaN bound (invalid ray, NaN tmax) stays NaN.
       entry = t_near > entry ? t_near : entry;

@@ -4,7 +4,8 @@
 // structure-of-arrays, as wide BVH nodes store their children (issue 4).
 // With BoxTest = SlabRobust the exit is padded by its rounding error as in
 // prim/aabb_slab_robust.h (Ize 2013): no box the exact ray touches is missed;
-// with SlabFma each distance is one fused multiply-add (prim/aabb_slab_fma.h).
+// with SlabRobustRay the same guarantee comes from reciprocals scaled once
+// per ray (prim/aabb_slab_robust_ray.h), no padding per box; with SlabFma each distance is one fused multiply-add (prim/aabb_slab_fma.h).
 // AVX2 (8 lanes) or SSE (4 lanes) when the compiler targets AVX2, else a
 // scalar loop, same answers.
 #pragma once
@@ -19,6 +20,7 @@
 #include "raybench/prim/aabb_slab.h"
 #include "raybench/prim/aabb_slab_fma.h"
 #include "raybench/prim/aabb_slab_robust.h"
+#include "raybench/prim/aabb_slab_robust_ray.h"
 #include "raybench/simd/lanes.h"
 #include "raybench/simd/wide_triangle.h"  // kHaveAvx2
 
@@ -80,19 +82,25 @@ struct BoxHits {
 // A ray as the SIMD test reads it, set up once per ray: its origin, 1/d and
 // o/d broadcast to every lane, and where each axis's entry planes lie in a
 // BBoxWide (lower, or upper for a negative 1/d), so a node's test is loads
-// and arithmetic only.
+// and arithmetic only. far_inv_dir is what the far planes' distances are
+// scaled by: 1/d, or SlabRobustRay's 1/d rounded outward.
 template <int W>
 struct RayLanes {
-  simd::FloatLanes<W> org[3], inv_dir[3], org_over_dir[3];
+  simd::FloatLanes<W> org[3], inv_dir[3], far_inv_dir[3], org_over_dir[3];
   int near_offset[3];  // from b.lower[a] to axis a's entry planes: 0 (lower) or 3W (upper)
   float tnear;
 
+  template <typename BoxTest = Slab>
   static RayLanes from(const Slab::Precomputed& r) {
     using F = simd::FloatLanes<W>;
     RayLanes lanes;
     for (int a = 0; a < 3; ++a) {
       lanes.org[a] = F::set1(r.org[a]);
       lanes.inv_dir[a] = F::set1(r.inv_dir[a]);
+      if constexpr (std::is_same_v<BoxTest, SlabRobustRay>)
+        lanes.far_inv_dir[a] = F::set1(SlabRobustRay::far_inv_dir(r.inv_dir[a]));
+      else
+        lanes.far_inv_dir[a] = lanes.inv_dir[a];
       lanes.org_over_dir[a] = F::set1(r.org[a] * r.inv_dir[a]);
       lanes.near_offset[a] = r.negative[a] ? 3 * W : 0;
     }
@@ -108,13 +116,19 @@ template <typename BoxTest = Slab, int W>
 RAYBENCH_INLINE BoxHits<W> slab_lanes(const RayLanes<W>& r, float tmax, const BBoxWide<W>& b) {
   using F = simd::FloatLanes<W>;
   constexpr bool kRobust = std::is_same_v<BoxTest, SlabRobust>;
+  constexpr bool kRobustRay = std::is_same_v<BoxTest, SlabRobustRay>;
   constexpr float kLargest = std::numeric_limits<float>::max();
   // Slab::overlaps asks entry <= exit and entry < +inf (an entry at +inf is
   // never reached). With the exit clamped to the largest float, entry <=
   // exit says both: one comparison per node instead of two and an and. The
   // clamp goes on tmax (std::min keeps a NaN tmax NaN, a miss), or, for the
   // robust test, on the padded exit, which may round up to +inf.
-  F t_entry = F::set1(r.tnear), t_exit = F::set1(kRobust ? tmax : std::min(tmax, kLargest));
+  // SlabRobustRay pads tmax (a NaN tmax stays NaN through std::min, a miss);
+  // its far distances come padded from far_inv_dir.
+  const float exit_bound = kRobustRay ? std::min(SlabRobustRay::padded(tmax), kLargest)
+                           : kRobust  ? tmax
+                                      : std::min(tmax, kLargest);
+  F t_entry = F::set1(r.tnear), t_exit = F::set1(exit_bound);
   // The box's 6W floats as one array: lower[a] at a * W, upper[a] at (3 + a) * W.
   static_assert(offsetof(BBoxWide<W>, upper) == 3 * W * sizeof(float) && sizeof(BBoxWide<W>) == 6 * W * sizeof(float));
   const float* planes = reinterpret_cast<const float*>(&b);
@@ -129,7 +143,7 @@ RAYBENCH_INLINE BoxHits<W> slab_lanes(const RayLanes<W>& r, float tmax, const BB
       t_exit = min(fmsub(far_plane, r.inv_dir[a], r.org_over_dir[a]), t_exit);
     } else {
       t_entry = max((near_plane - r.org[a]) * r.inv_dir[a], t_entry);
-      t_exit = min((far_plane - r.org[a]) * r.inv_dir[a], t_exit);
+      t_exit = min((far_plane - r.org[a]) * r.far_inv_dir[a], t_exit);
     }
   }
   if constexpr (kRobust) {
@@ -144,7 +158,9 @@ template <typename BoxTest = Slab, int W>
 inline unsigned intersect_boxes_simd(const Slab::Precomputed& r, float tmax, const BBoxWide<W>& b, float entry[W]) {
   if constexpr (std::is_same_v<BoxTest, SlabFma>)
     if (!SlabFma::fused(r)) return intersect_boxes_simd<Slab>(r, tmax, b, entry);
-  const BoxHits<W> h = slab_lanes<BoxTest>(RayLanes<W>::from(r), tmax, b);
+  if constexpr (std::is_same_v<BoxTest, SlabRobustRay>)
+    if (!SlabRobustRay::folds(r)) return intersect_boxes_simd<SlabRobust>(r, tmax, b, entry);
+  const BoxHits<W> h = slab_lanes<BoxTest>(RayLanes<W>::template from<BoxTest>(r), tmax, b);
   alignas(32) float t[W];
   h.t_entry.storeu(t);
   const unsigned mask = h.hit.mask();
