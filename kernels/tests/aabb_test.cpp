@@ -396,43 +396,36 @@ TEST(Slab, KnownLimitation_MissesBoxTheExactRayTouchesAtACorner) {
   EXPECT_FALSE(hits<Slab>(kCornerGrazer, kUnit));
 }
 
-TEST(SlabRobust, HitsBoxTheUnpaddedTestMissesByRounding) {
+// The two conservative tests: SlabRobust pads each exit, SlabRobustRay folds
+// the same 8u into the ray (the far planes' 1/d and tmax).
+template <typename Box>
+class ConservativeBoxTests : public ::testing::Test {};
+using ConservativeBoxes = ::testing::Types<SlabRobust, SlabRobustRay>;
+TYPED_TEST_SUITE(ConservativeBoxTests, ConservativeBoxes);
+
+TYPED_TEST(ConservativeBoxTests, HitsBoxTheUnpaddedTestMissesByRounding) {
   BoxHit h;
-  ASSERT_TRUE(hits<SlabRobust>(kCornerGrazer, kUnit, &h));
+  ASSERT_TRUE(hits<TypeParam>(kCornerGrazer, kUnit, &h));
   EXPECT_EQ(h.t_entry, 1.0f);
   EXPECT_GE(h.t_exit, 1.0f);
 }
 
-TEST(SlabRobust, PadsTheExitByEightUnitRoundoffsAndNoMore) {
+TYPED_TEST(ConservativeBoxTests, PadsTheExitByEightUnitRoundoffsAndNoMore) {
   // Along +x through the unit box: exit 2, padded to 2 + 2 * 2^-21.
   BoxHit h;
-  ASSERT_TRUE(hits<SlabRobust>(ray({-1, 0.5f, 0.5f}, {1, 0, 0}), kUnit, &h));
+  ASSERT_TRUE(hits<TypeParam>(ray({-1, 0.5f, 0.5f}, {1, 0, 0}), kUnit, &h));
   EXPECT_EQ(h.t_exit, 0x1.000008p+1f);  // 2 (1 + 2^-21)
   // o = 0, d = (1,1,0); box x in [1,2], y in [2 + g, 3]: exact entry 2 + g,
   // exact exit 2, a miss by g. Within the pad (g = 2^-21) the conservative
   // test reports it; beyond (g = 2^-19) it does not.
-  EXPECT_TRUE(hits<SlabRobust>(ray({0, 0, 0.5f}, {1, 1, 0}), box({1, 2 + 0x1p-21f, 0}, {2, 3, 1})));
-  EXPECT_FALSE(hits<SlabRobust>(ray({0, 0, 0.5f}, {1, 1, 0}), box({1, 2 + 0x1p-19f, 0}, {2, 3, 1})));
+  EXPECT_TRUE(hits<TypeParam>(ray({0, 0, 0.5f}, {1, 1, 0}), box({1, 2 + 0x1p-21f, 0}, {2, 3, 1})));
+  EXPECT_FALSE(hits<TypeParam>(ray({0, 0, 0.5f}, {1, 1, 0}), box({1, 2 + 0x1p-19f, 0}, {2, 3, 1})));
   EXPECT_FALSE(hits<Slab>(ray({0, 0, 0.5f}, {1, 1, 0}), box({1, 2 + 0x1p-21f, 0}, {2, 3, 1})));
 }
 
-TEST(SlabRobustRay, HitsBoxTheUnpaddedTestMissesByRounding) {
-  BoxHit h;
-  ASSERT_TRUE(hits<SlabRobustRay>(kCornerGrazer, kUnit, &h));
-  EXPECT_EQ(h.t_entry, 1.0f);
-  EXPECT_GE(h.t_exit, 1.0f);
-}
-
-TEST(SlabRobustRay, ScalesTheFarPlanesReciprocalsAndTmaxByEightUnitRoundoffsAndNoMore) {
-  // Along +x through the unit box: the exit 2 * fl(1 * (1 + 2^-21)).
-  BoxHit h;
-  ASSERT_TRUE(hits<SlabRobustRay>(ray({-1, 0.5f, 0.5f}, {1, 0, 0}), kUnit, &h));
-  EXPECT_EQ(h.t_exit, 0x1.000008p+1f);
-  // The same near miss as SlabRobust's: a gap of 2^-21 is reported, 2^-19 not.
-  EXPECT_TRUE(hits<SlabRobustRay>(ray({0, 0, 0.5f}, {1, 1, 0}), box({1, 2 + 0x1p-21f, 0}, {2, 3, 1})));
-  EXPECT_FALSE(hits<SlabRobustRay>(ray({0, 0, 0.5f}, {1, 1, 0}), box({1, 2 + 0x1p-19f, 0}, {2, 3, 1})));
-  // tmax is padded too: a box entered at t = 1 is reported for tmax one ulp
-  // below 1, not for tmax 2^-18 below.
+TEST(SlabRobustRay, PadsTmaxByEightUnitRoundoffsAndNoMore) {
+  // A box entered at t = 1 is reported for tmax one ulp below 1, not for
+  // tmax 2^-18 below.
   const Vec3f o{-1, 0.5f, 0.5f}, d{1, 0, 0};
   EXPECT_FALSE(hits<Slab>(ray(o, d, 0.0f, 0x1.fffffep-1f), kUnit));
   EXPECT_TRUE(hits<SlabRobustRay>(ray(o, d, 0.0f, 0x1.fffffep-1f), kUnit));
