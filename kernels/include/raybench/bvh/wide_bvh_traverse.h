@@ -155,7 +155,7 @@ inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
   // test compares with the padded bound, so it never skips what it entered.
   const auto reachable = [](float entry, float tmax) {
     if constexpr (std::is_same_v<BoxTest, SlabRobust> || std::is_same_v<BoxTest, SlabRobustRay>)
-      return entry <= SlabRobustRay::padded(tmax);
+      return entry <= SlabRobust::padded(tmax);
     else return entry <= tmax;
   };
   float tmax = ray.tfar;

@@ -56,13 +56,16 @@ struct SlabRobust {
   using Precomputed = Slab::Precomputed;
   static Precomputed precompute(const Ray& ray) { return Slab::precompute(ray); }
 
+  // An exit (or tmax) padded by 8u. Sign-safe: moves a negative value up
+  // too. +inf stays +inf, NaN stays NaN (a miss), -inf becomes NaN (a miss,
+  // as it was).
+  static float padded(float t_exit) { return t_exit + std::fabs(t_exit) * kPad; }
+
   // On a hit, t_entry is as computed (for ordering children) and t_exit is
   // padded: it may exceed the exact exit by a few ulps.
   static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
     BoxHit h = Slab::clip(ray, box, tmax);
-    // Sign-safe: moves the exit up for negative values too. +inf stays +inf,
-    // NaN stays NaN (a miss), -inf becomes NaN (a miss, as it was).
-    h.t_exit = h.t_exit + std::fabs(h.t_exit) * kPad;
+    h.t_exit = padded(h.t_exit);
     if (!Slab::overlaps(h)) return false;
     out = h;
     return true;

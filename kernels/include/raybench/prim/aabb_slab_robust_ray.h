@@ -54,8 +54,6 @@ struct SlabRobustRay {
   // invalid ray's NaN, which SlabRobust misses as well).
   static bool folds(const Precomputed& ray) { return ray.tnear >= 0.0f; }
   static float far_inv_dir(float inv_dir) { return inv_dir * kFarScale; }
-  // tmax as SlabRobust pads an exit: +inf stays +inf, NaN stays NaN.
-  static float padded(float tmax) { return tmax + std::fabs(tmax) * SlabRobust::kPad; }
 
   // On a hit, t_entry is as computed and t_exit may exceed the exact exit
   // by a few ulps. A traversal computes the scaled reciprocals once per ray
@@ -63,7 +61,7 @@ struct SlabRobustRay {
   RAYBENCH_INLINE static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
     if (!folds(ray)) return SlabRobust::intersect(ray, box, tmax, out);
     const Vec3f far{far_inv_dir(ray.inv_dir.x), far_inv_dir(ray.inv_dir.y), far_inv_dir(ray.inv_dir.z)};
-    const BoxHit h = Slab::clip(ray, far, box, padded(tmax));
+    const BoxHit h = Slab::clip(ray, far, box, SlabRobust::padded(tmax));
     if (!Slab::overlaps(h)) return false;
     out = h;
     return true;

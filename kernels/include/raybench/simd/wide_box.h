@@ -5,7 +5,8 @@
 // With BoxTest = SlabRobust the exit is padded by its rounding error as in
 // prim/aabb_slab_robust.h (Ize 2013): no box the exact ray touches is missed;
 // with SlabRobustRay the same guarantee comes from reciprocals scaled once
-// per ray (prim/aabb_slab_robust_ray.h), no padding per box; with SlabFma each distance is one fused multiply-add (prim/aabb_slab_fma.h).
+// per ray (prim/aabb_slab_robust_ray.h), no padding per box; with SlabFma
+// each distance is one fused multiply-add (prim/aabb_slab_fma.h).
 // AVX2 (8 lanes) or SSE (4 lanes) when the compiler targets AVX2, else a
 // scalar loop, same answers.
 #pragma once
@@ -125,7 +126,7 @@ RAYBENCH_INLINE BoxHits<W> slab_lanes(const RayLanes<W>& r, float tmax, const BB
   // robust test, on the padded exit, which may round up to +inf.
   // SlabRobustRay pads tmax (a NaN tmax stays NaN through std::min, a miss);
   // its far distances come padded from far_inv_dir.
-  const float exit_bound = kRobustRay ? std::min(SlabRobustRay::padded(tmax), kLargest)
+  const float exit_bound = kRobustRay ? std::min(SlabRobust::padded(tmax), kLargest)
                            : kRobust  ? tmax
                                       : std::min(tmax, kLargest);
   F t_entry = F::set1(r.tnear), t_exit = F::set1(exit_bound);
