@@ -1,11 +1,18 @@
 // Single-ray traversal of a WideBvh<W> (W = 8: AVX2, W = 4: SSE, or their
 // scalar fallback): one W-wide slab test per node; the children entered are
 // pushed in the node's stored far-to-near order for the ray's octant
-// (WideNode::far_to_near), so the nearest is popped next, without sorting
-// distances: one permutation orders them and a table-driven compaction
-// pushes them with two stores, branch-free. Their entry distances go on the
-// stack too, so a subtree farther than the current hit is skipped when
-// popped. Leaves are tested W triangles at once.
+// (WideNode::far_to_near), without sorting distances: one permutation orders
+// them and a table-driven compaction pushes them with two stores,
+// branch-free. Their entry distances go on the stack too, so a subtree
+// farther than the current hit is skipped when popped. Leaves are tested W
+// triangles at once.
+// The traversal descends straight into the nearest child entered instead of
+// popping it back: a node's reference then comes from the node itself, not
+// through a store and a load of the stack, and a node with one child entered
+// (the commonest case) pushes nothing, as Embree's traversal does
+// (bvh_traverser1.h). Measured against pushing every child and popping,
+// one thread, default build, same answers: primary rays 1.28-1.40x on
+// Sponza, Sibenik and Sponza-Dabrovic, diffuse 1.10-1.12x, shadow 1.12-1.16x.
 // Any hit (shadow rays) returns at the first hit in the interval and orders
 // nothing per ray: the children entered are pushed in the node's lane order,
 // ref only (its interval never shrinks, so no entry distance is needed), as
@@ -160,15 +167,9 @@ inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
   };
   float tmax = ray.tfar;
   wide_bvh_detail::Stack<W> stack;
-  stack.ref[0] = 0;
-  stack.entry[0] = r.tnear;
-  stack.top = 1;
-  while (stack.top > 0) {
-    --stack.top;
-    const std::uint32_t ref = stack.ref[stack.top];
-    // A hit closer than this subtree was found meanwhile (closest hit only:
-    // any hit returns at its first).
-    if (!AnyHit && !reachable(stack.entry[stack.top], tmax)) continue;
+  stack.top = 0;
+  std::uint32_t ref = 0;  // the node or leaf visited next: the root first
+  for (;;) {
     if (ref & WideBvh<W>::kLeafBit) {
       const std::uint32_t pack = ref & ~WideBvh<W>::kLeafBit;
       TriangleHit th{};  // set when a lane hits (initialised: the scalar fallback sets it conditionally)
@@ -178,31 +179,52 @@ inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
         hit = {th.t, bvh.pack_prims[W * pack + static_cast<std::uint32_t>(lane)], th.u, th.v};
         if (AnyHit) return hit;
       }
-      continue;
-    }
-    const WideNode<W>& node = bvh.nodes[ref];
-#if defined(__AVX2__)
-    const BoxHits<W> box = slab_lanes<BoxTest>(ray_lanes, tmax, node.bounds);
-    if constexpr (AnyHit) {
-      const unsigned entered = box.hit.mask();
-      if (entered) wide_bvh_detail::push_compacted(stack, simd::IntLanes<W>::load(node.child), entered);
     } else {
-      // Permute the node's lanes into far-to-near order, then push the
-      // entered ones compacted.
-      const simd::IntLanes<W> order =
-          wide_bvh_detail::unpack_lanes<W, WideNode<W>::kOrderBits>(node.far_to_near[octant]);
-      const unsigned entered = box.hit.permute(order).mask();
-      if (!entered) continue;
-      const simd::IntLanes<W> refs = simd::IntLanes<W>::load(node.child).permute(order);
-      wide_bvh_detail::push_compacted(stack, refs, box.t_entry.permute(order), entered);
-    }
+      const WideNode<W>& node = bvh.nodes[ref];
+#if defined(__AVX2__)
+      const BoxHits<W> box = slab_lanes<BoxTest>(ray_lanes, tmax, node.bounds);
+      const unsigned hit_lanes = box.hit.mask();
+      // Descend straight into the child visited next, without a round trip
+      // through the stack; its entry distance is within tmax (the box test
+      // just compared them). One child entered: nothing else to do.
+      if (hit_lanes != 0 && (hit_lanes & (hit_lanes - 1)) == 0) {
+        ref = node.child[__builtin_ctz(hit_lanes)];
+        continue;
+      }
+      if constexpr (AnyHit) {
+        // In lane order; the highest lane entered is visited first.
+        if (hit_lanes) {
+          wide_bvh_detail::push_compacted(stack, simd::IntLanes<W>::load(node.child), hit_lanes);
+          --stack.top;
+          ref = node.child[31 - __builtin_clz(hit_lanes)];
+          continue;
+        }
+      } else if (hit_lanes) {
+        // Permute the node's lanes into far-to-near order, push the entered
+        // ones compacted, and visit the nearest (pushed last) at once.
+        const simd::IntLanes<W> order =
+            wide_bvh_detail::unpack_lanes<W, WideNode<W>::kOrderBits>(node.far_to_near[octant]);
+        const unsigned entered = box.hit.permute(order).mask();
+        const simd::IntLanes<W> refs = simd::IntLanes<W>::load(node.child).permute(order);
+        wide_bvh_detail::push_compacted(stack, refs, box.t_entry.permute(order), entered);
+        --stack.top;
+        ref = node.child[far_to_near_lane(node, octant, 31 - __builtin_clz(entered))];
+        continue;
+      }
 #else
-    alignas(32) float entry[W];
-    const unsigned entered = intersect_boxes<BoxTest>(r, tmax, node.bounds, entry);
-    wide_bvh_detail::push_children_scalar<!AnyHit>(stack, node, octant, entered, entry);
+      alignas(32) float entry[W];
+      const unsigned entered = intersect_boxes<BoxTest>(r, tmax, node.bounds, entry);
+      wide_bvh_detail::push_children_scalar<!AnyHit>(stack, node, octant, entered, entry);
 #endif
+    }
+    // Pop the next subtree, skipping those farther than a hit found since
+    // they were pushed (closest hit only: any hit returns at its first).
+    do {
+      if (stack.top == 0) return hit;
+      --stack.top;
+    } while (!AnyHit && !reachable(stack.entry[stack.top], tmax));
+    ref = stack.ref[stack.top];
   }
-  return hit;
 }
 
 template <typename Leaf = WideMollerTrumbore, typename BoxTest = SlabFma, int W>
