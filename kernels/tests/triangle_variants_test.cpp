@@ -152,6 +152,19 @@ TEST(Watertight, ARayThroughASharedEdgeHitsOneOfTheTwoTriangles) {
   EXPECT_TRUE(hits<WatertightTriangle>(r, a) || hits<WatertightTriangle>(r, b));
 }
 
+TEST(Watertight, ATriangleWithTwoEqualVerticesMissesRaysThroughItsSegmentAndEnds) {
+  // One determinant is 0 in float for every ray; the two others decide
+  // (opposite signs off the segment's line), or the double fallback does
+  // (on it: all three 0, det 0).
+  const Triangle seg{{0, 0, 0}, {1, 0.5f, 0}, {1, 0.5f, 0}};
+  for (float x : {-0.5f, 0.0f, 0.25f, 0.5f, 1.0f, 1.5f})
+    for (float y : {-0.25f, 0.0f, 0.125f, 0.25f, 0.5f, 1.0f})
+      for (const Vec3f dir : {Vec3f{0, 0, -1}, normalize(Vec3f{0.3f, -0.2f, -1})}) {
+        const Vec3f org = Vec3f{x, y, 0} - dir * 2.0f;
+        EXPECT_FALSE(hits<WatertightTriangle>(ray(org, dir), seg)) << x << " " << y;
+      }
+}
+
 TEST(MollerTrumbore, KnownFailure_LeaksThroughSharedEdgesOfAClosedMesh) {
   // EXTREMES.md: 11 % of edge-aimed and 10 % of vertex-aimed rays miss.
   // Not watertight: the float edge tests of neighbours do not agree.

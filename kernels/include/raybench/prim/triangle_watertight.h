@@ -58,13 +58,23 @@ struct WatertightTriangle {
     float u = cx * by - cy * bx;  // weight of v0
     float v = ax * cy - ay * cx;  // weight of v1
     float w = bx * ay - by * ax;  // weight of v2
+    // A determinant that is not 0 in float has its exact sign (rounding is
+    // monotone: p > q gives fl(p) >= fl(q)), so one strictly negative and one
+    // strictly positive already say the origin is outside, whatever the
+    // others are. Only then are zeros decided, or a triangle with two equal
+    // vertices (one determinant always 0) would take the double path on
+    // every test.
+    const auto outside = [](float u, float v, float w) {
+      return (u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f);
+    };
+    if (outside(u, v, w)) return false;
     if (u == 0.0f || v == 0.0f || w == 0.0f) {
       // On an edge in float: decide in double, where these products are exact.
       u = static_cast<float>(static_cast<double>(cx) * by - static_cast<double>(cy) * bx);
       v = static_cast<float>(static_cast<double>(ax) * cy - static_cast<double>(ay) * cx);
       w = static_cast<float>(static_cast<double>(bx) * ay - static_cast<double>(by) * ax);
+      if (outside(u, v, w)) return false;
     }
-    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
     const float det = u + v + w;
     if (!(det != 0.0f)) return false;  // degenerate (or NaN)
     const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];

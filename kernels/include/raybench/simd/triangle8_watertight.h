@@ -76,13 +76,16 @@ inline int intersect8_watertight_avx2(const WatertightTriangle::RayData& r, floa
   const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
   const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
   const __m256 zero = _mm256_setzero_ps();
-  // Lanes on an edge in float: the scalar test decides them in double.
-  const int exact = _mm256_movemask_ps(_mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
-                                                    _mm256_cmp_ps(w, zero, _CMP_EQ_OQ)));
   const __m256 any_negative = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_LT_OQ), _mm256_cmp_ps(v, zero, _CMP_LT_OQ)),
                                            _mm256_cmp_ps(w, zero, _CMP_LT_OQ));
   const __m256 any_positive = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_GT_OQ), _mm256_cmp_ps(v, zero, _CMP_GT_OQ)),
                                            _mm256_cmp_ps(w, zero, _CMP_GT_OQ));
+  const __m256 outside = _mm256_and_ps(any_negative, any_positive);
+  // Lanes on an edge in float and not already outside: the scalar test
+  // decides them in double.
+  const __m256 on_edge = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
+                                      _mm256_cmp_ps(w, zero, _CMP_EQ_OQ));
+  const int exact = _mm256_movemask_ps(_mm256_andnot_ps(outside, on_edge));
   const __m256 det = _mm256_add_ps(_mm256_add_ps(u, v), w);
   const __m256 t_scaled = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(u, _mm256_mul_ps(sz, z[0])), _mm256_mul_ps(v, _mm256_mul_ps(sz, z[1]))),
                                         _mm256_mul_ps(w, _mm256_mul_ps(sz, z[2])));
@@ -90,7 +93,7 @@ inline int intersect8_watertight_avx2(const WatertightTriangle::RayData& r, floa
   const __m256 positive = _mm256_cmp_ps(det, zero, _CMP_GT_OQ);
   const __m256 in_positive = _mm256_and_ps(_mm256_cmp_ps(t_scaled, lo, _CMP_GT_OQ), _mm256_cmp_ps(t_scaled, hi, _CMP_LE_OQ));
   const __m256 in_negative = _mm256_and_ps(_mm256_cmp_ps(t_scaled, lo, _CMP_LT_OQ), _mm256_cmp_ps(t_scaled, hi, _CMP_GE_OQ));
-  __m256 ok = _mm256_andnot_ps(_mm256_and_ps(any_negative, any_positive), _mm256_cmp_ps(det, zero, _CMP_NEQ_OQ));
+  __m256 ok = _mm256_andnot_ps(outside, _mm256_cmp_ps(det, zero, _CMP_NEQ_OQ));
   ok = _mm256_and_ps(ok, _mm256_blendv_ps(in_negative, in_positive, positive));
   const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
   const __m256 tt = _mm256_mul_ps(t_scaled, inv_det);
