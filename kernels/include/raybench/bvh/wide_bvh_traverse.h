@@ -126,7 +126,7 @@ struct WideMollerTrumbore {
   using RayData = Ray;
   static RayData precompute(const Ray& ray) { return ray; }
   template <int W>
-  static int intersect(const RayData& ray, float tmax, const WideBvh<W>& bvh, std::uint32_t pack, TriangleHit& out) {
+  RAYBENCH_INLINE static int intersect(const RayData& ray, float tmax, const WideBvh<W>& bvh, std::uint32_t pack, TriangleHit& out) {
     return intersect_pack(ray, tmax, bvh.packs[pack], out);
   }
 };
@@ -135,7 +135,7 @@ struct Bvh8Watertight {
   static constexpr WideLeaves kLeaves = WideLeaves::kVertices;
   using RayData = WatertightTriangle::RayData;
   static RayData precompute(const Ray& ray) { return WatertightTriangle::precompute(ray); }
-  static int intersect(const RayData& ray, float tmax, const Bvh8& bvh, std::uint32_t pack, TriangleHit& out) {
+  RAYBENCH_INLINE static int intersect(const RayData& ray, float tmax, const Bvh8& bvh, std::uint32_t pack, TriangleHit& out) {
     return intersect8_watertight(ray, tmax, bvh.vertex_packs[pack], out);
   }
 };

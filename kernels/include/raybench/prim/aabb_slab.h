@@ -57,7 +57,7 @@ struct Slab {
     float tnear;       // the ray's tnear, or NaN for a ray with NaN/Inf in org or dir
   };
 
-  static Precomputed precompute(const Ray& ray) {
+  RAYBENCH_INLINE static Precomputed precompute(const Ray& ray) {
     Precomputed p;
     p.org = ray.org;
     p.inv_dir = {1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z};

@@ -61,7 +61,7 @@ inline int intersect8_watertight_scalar(const WatertightTriangle::RayData& ray, 
 }
 
 #if defined(__AVX2__)
-inline int intersect8_watertight_avx2(const WatertightTriangle::RayData& r, float tmax, const TriangleVertices8& t,
+RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData& r, float tmax, const TriangleVertices8& t,
                                       TriangleHit& out) {
   const __m256 sx = _mm256_set1_ps(r.sx), sy = _mm256_set1_ps(r.sy), sz = _mm256_set1_ps(r.sz);
   const __m256 ox = _mm256_set1_ps(r.org[r.kx]), oy = _mm256_set1_ps(r.org[r.ky]), oz = _mm256_set1_ps(r.org[r.kz]);
@@ -123,7 +123,7 @@ inline int intersect8_watertight_avx2(const WatertightTriangle::RayData& r, floa
 }
 #endif
 
-inline int intersect8_watertight(const WatertightTriangle::RayData& ray, float tmax, const TriangleVertices8& t,
+RAYBENCH_INLINE int intersect8_watertight(const WatertightTriangle::RayData& ray, float tmax, const TriangleVertices8& t,
                                  TriangleHit& out) {
 #if defined(__AVX2__)
   return intersect8_watertight_avx2(ray, tmax, t, out);

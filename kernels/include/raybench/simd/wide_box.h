@@ -92,7 +92,7 @@ struct RayLanes {
   float tnear;
 
   template <typename BoxTest = Slab>
-  static RayLanes from(const Slab::Precomputed& r) {
+  RAYBENCH_INLINE static RayLanes from(const Slab::Precomputed& r) {
     using F = simd::FloatLanes<W>;
     RayLanes lanes;
     for (int a = 0; a < 3; ++a) {
