@@ -140,8 +140,13 @@ struct Bvh8Watertight {
   }
 };
 
+// Inlined into the caller's loop over rays: called, the ray a backend has
+// just adjusted (with_nonnegative_tnear) goes through memory, and the
+// traversal's first loads of it, spanning two stores, wait for them (store
+// forwarding fails). Measured: bvh8:reinsert 9 % faster on Conference's
+// shadow rays inlined.
 template <bool AnyHit, typename Leaf = WideMollerTrumbore, typename BoxTest = SlabFma, int W>
-inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
+RAYBENCH_INLINE Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
   Hit hit;
   if (bvh.nodes.empty()) return hit;
   const Slab::Precomputed r = Slab::precompute(ray);
@@ -228,11 +233,11 @@ inline Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
 }
 
 template <typename Leaf = WideMollerTrumbore, typename BoxTest = SlabFma, int W>
-inline Hit intersect_wide(const WideBvh<W>& bvh, const Ray& ray) {
+RAYBENCH_INLINE Hit intersect_wide(const WideBvh<W>& bvh, const Ray& ray) {
   return traverse_wide<false, Leaf, BoxTest>(bvh, ray);
 }
 template <typename Leaf = WideMollerTrumbore, typename BoxTest = SlabFma, int W>
-inline bool occluded_wide(const WideBvh<W>& bvh, const Ray& ray) {
+RAYBENCH_INLINE bool occluded_wide(const WideBvh<W>& bvh, const Ray& ray) {
   return traverse_wide<true, Leaf, BoxTest>(bvh, ray).hit();
 }
 
