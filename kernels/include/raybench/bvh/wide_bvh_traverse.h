@@ -18,7 +18,7 @@
 // ref only (its interval never shrinks, so no entry distance is needed), as
 // Embree's any-hit traversal does. With WideLaneOrder::kByArea (the
 // backends' default build) the collapse puts the children in the lanes by
-// decreasing box area, so the smallest is popped first: small boxes are
+// decreasing box area, so the smallest is visited first: small boxes are
 // mostly full of geometry, large ones mostly empty space (the probability
 // of occlusion per cost, Ize & Hansen, "RTSAH Traversal Order for Occlusion
 // Rays", EG 2011, which smallest-first approximates). Measured on the
