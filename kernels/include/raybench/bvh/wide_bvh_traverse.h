@@ -150,14 +150,11 @@ RAYBENCH_INLINE Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
   Hit hit;
   if (bvh.nodes.empty()) return hit;
   const Slab::Precomputed r = Slab::precompute(ray);
-  // The fused box test's loop serves rays with no zero direction component;
-  // the others take Slab's, which is exact for them (aabb_slab_fma.h).
-  if constexpr (std::is_same_v<BoxTest, SlabFma>)
-    if (!SlabFma::fused(r)) return traverse_wide<AnyHit, Leaf, Slab>(bvh, ray);
-  // The padding folded into the ray holds for tnear >= 0 only
-  // (aabb_slab_robust_ray.h); other rays pad every exit.
-  if constexpr (std::is_same_v<BoxTest, SlabRobustRay>)
-    if (!SlabRobustRay::folds(r)) return traverse_wide<AnyHit, Leaf, SlabRobust>(bvh, ray);
+  // SlabFma serves rays with no zero direction component (the others take
+  // Slab, exact for them), SlabRobustRay rays with tnear >= 0 (the others
+  // pad every exit): the whole traversal runs with the test the ray gets.
+  if constexpr (HasFallback<BoxTest>)
+    if (!BoxTest::serves(r)) return traverse_wide<AnyHit, Leaf, typename BoxTest::Fallback>(bvh, ray);
   const int octant = ray_octant(r);
 #if defined(__AVX2__)
   const RayLanes<W> ray_lanes = RayLanes<W>::template from<BoxTest>(r);

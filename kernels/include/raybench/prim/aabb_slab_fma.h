@@ -12,8 +12,8 @@
 // For a zero direction component 1/d is infinite and o * (1/d) infinite or
 // NaN, and the fused form would turn the exact answer for a ray parallel to
 // a slab (aabb_slab.h) into NaN: a ray with any zero component is tested as
-// Slab tests it. Which form a ray gets is decided once per ray (fused()),
-// so a traversal picks its loop once.
+// Slab tests it (the Fallback). Which form a ray gets is decided once per
+// ray (serves()), so a traversal picks its loop once.
 #pragma once
 
 #include <cmath>
@@ -35,13 +35,14 @@ struct SlabFma {
   using Precomputed = Slab::Precomputed;
   static Precomputed precompute(const Ray& ray) { return Slab::precompute(ray); }
 
-  // Whether the ray gets the fused form: every 1/d finite.
-  static bool fused(const Precomputed& r) {
+  // Whether the ray gets the fused form: every 1/d finite. Others get Slab.
+  using Fallback = Slab;
+  static bool serves(const Precomputed& r) {
     return std::isfinite(r.inv_dir.x) && std::isfinite(r.inv_dir.y) && std::isfinite(r.inv_dir.z);
   }
 
   RAYBENCH_INLINE static BoxHit clip(const Precomputed& r, const BBox& box, float tmax) {
-    if (!fused(r)) return Slab::clip(r, box, tmax);
+    if (!serves(r)) return Fallback::clip(r, box, tmax);
     float entry = r.tnear, exit = tmax;
     for (int axis = 0; axis < 3; ++axis) {
       const float near_plane = r.negative[axis] ? box.upper[axis] : box.lower[axis];

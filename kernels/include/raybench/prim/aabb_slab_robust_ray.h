@@ -51,15 +51,16 @@ struct SlabRobustRay {
   static Precomputed precompute(const Ray& ray) { return Slab::precompute(ray); }
 
   // Whether the folded padding holds for this ray (tnear >= 0; false for an
-  // invalid ray's NaN, which SlabRobust misses as well).
-  static bool folds(const Precomputed& ray) { return ray.tnear >= 0.0f; }
+  // invalid ray's NaN, which SlabRobust misses as well). Others get SlabRobust.
+  using Fallback = SlabRobust;
+  static bool serves(const Precomputed& ray) { return ray.tnear >= 0.0f; }
   static float far_inv_dir(float inv_dir) { return inv_dir * kFarScale; }
 
   // On a hit, t_entry is as computed and t_exit may exceed the exact exit
   // by a few ulps. A traversal computes the scaled reciprocals once per ray
   // (RayLanes); here they are recomputed per box.
   RAYBENCH_INLINE static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
-    if (!folds(ray)) return SlabRobust::intersect(ray, box, tmax, out);
+    if (!serves(ray)) return Fallback::intersect(ray, box, tmax, out);
     const Vec3f far{far_inv_dir(ray.inv_dir.x), far_inv_dir(ray.inv_dir.y), far_inv_dir(ray.inv_dir.z)};
     const BoxHit h = Slab::clip(ray, far, box, SlabRobust::padded(tmax));
     if (!Slab::overlaps(h)) return false;

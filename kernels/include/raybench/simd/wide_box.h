@@ -71,6 +71,12 @@ inline unsigned intersect_boxes_scalar(const Slab::Precomputed& r, float tmax, c
   return mask;
 }
 
+// A box test that serves only some rays (SlabFma: no zero direction
+// component; SlabRobustRay: tnear >= 0) names the test the others get:
+// BoxTest::Fallback when !BoxTest::serves(r). Callers pick it once per ray.
+template <typename BoxTest>
+concept HasFallback = requires { typename BoxTest::Fallback; };
+
 #if defined(__AVX2__)
 // The SIMD test with its answers left in registers for the traversal to
 // permute: `hit` all ones in the lanes entered, `t_entry` their entry
@@ -111,7 +117,7 @@ struct RayLanes {
 };
 
 // With BoxTest = SlabFma each distance is one fused multiply-add; the
-// caller has checked SlabFma::fused(r) (every 1/d finite), as
+// caller has checked SlabFma::serves(r) (every 1/d finite), as
 // intersect_boxes_simd and traverse_wide do once per ray.
 template <typename BoxTest = Slab, int W>
 RAYBENCH_INLINE BoxHits<W> slab_lanes(const RayLanes<W>& r, float tmax, const BBoxWide<W>& b) {
@@ -157,10 +163,8 @@ RAYBENCH_INLINE BoxHits<W> slab_lanes(const RayLanes<W>& r, float tmax, const BB
 
 template <typename BoxTest = Slab, int W>
 inline unsigned intersect_boxes_simd(const Slab::Precomputed& r, float tmax, const BBoxWide<W>& b, float entry[W]) {
-  if constexpr (std::is_same_v<BoxTest, SlabFma>)
-    if (!SlabFma::fused(r)) return intersect_boxes_simd<Slab>(r, tmax, b, entry);
-  if constexpr (std::is_same_v<BoxTest, SlabRobustRay>)
-    if (!SlabRobustRay::folds(r)) return intersect_boxes_simd<SlabRobust>(r, tmax, b, entry);
+  if constexpr (HasFallback<BoxTest>)
+    if (!BoxTest::serves(r)) return intersect_boxes_simd<typename BoxTest::Fallback>(r, tmax, b, entry);
   const BoxHits<W> h = slab_lanes<BoxTest>(RayLanes<W>::template from<BoxTest>(r), tmax, b);
   alignas(32) float t[W];
   h.t_entry.storeu(t);
