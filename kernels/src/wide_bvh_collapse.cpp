@@ -261,7 +261,7 @@ class Collapser {
 
   // With WideLaneOrder::kByArea the node's lanes hold its children by
   // decreasing box area (ties in the plan's order, the BVH2's): any-hit
-  // traversal pushes them in lane order, so it pops the smallest first
+  // traversal visits the highest lane entered first, so the smallest box
   // (wide_bvh_traverse.h says why).
   void fill_node(std::size_t i) {
     const Plan& p = plans_[i];

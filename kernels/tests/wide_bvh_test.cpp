@@ -394,7 +394,7 @@ TEST_P(WideBvhBuild, TheCollapseHasTheLeastSahCostOfAnyWideTreeCutFromTheBvh2) {
 }
 
 TEST_P(WideBvhBuild, ByAreaEveryNodeHoldsItsChildrenByDecreasingBoxAreaEmptyLanesLast) {
-  // The any-hit traversal pops the smallest child first (wide_bvh_traverse.h);
+  // The any-hit traversal visits the smallest child first (wide_bvh_traverse.h);
   // in the BVH2's order it does not.
   const auto tris = random_soup(5000, 4);
   for_each_width([&](auto width) {

@@ -68,7 +68,7 @@ enum class WideLeaves { kMollerTrumbore, kVertices };
 
 // The order of a node's children in its lanes, which is the order any-hit
 // traversal visits them in (wide_bvh_traverse.h): by decreasing box area
-// (the smallest popped first), or the BVH2's own order (left before right).
+// (the smallest visited first), or the BVH2's own order (left before right).
 enum class WideLaneOrder { kByArea, kBvh2 };
 
 template <int W>
