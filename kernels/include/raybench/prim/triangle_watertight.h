@@ -10,6 +10,13 @@
 // a shared edge or vertex hits at least one of them: no cracks. When a
 // determinant is exactly 0 in float it is recomputed in double (the paper's
 // fallback), so the edge decision is exact for these inputs.
+// Two departures from the paper, both outside the edge test, so neither
+// opens a crack: the shear x - Sx*z is one fused multiply-add (a vertex still
+// gets the same sheared coordinates in every triangle that has it; the 2x2
+// determinants are not fused, which would break their antisymmetry), and
+// the distance interval is checked once, on the divided t, not first on the
+// scaled t as well (an early reject for scalar code; the 8-wide test divides
+// every lane anyway).
 // Not culled: both faces hit. Degenerate triangles (U+V+W == 0) miss.
 #pragma once
 
@@ -52,9 +59,10 @@ struct WatertightTriangle {
 
   static bool intersect(const RayData& r, float tmax, const Triangle& tri, TriangleHit& out) {
     const Vec3f a = tri.v0 - r.org, b = tri.v1 - r.org, c = tri.v2 - r.org;
-    const float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
-    const float bx = b[r.kx] - r.sx * b[r.kz], by = b[r.ky] - r.sy * b[r.kz];
-    const float cx = c[r.kx] - r.sx * c[r.kz], cy = c[r.ky] - r.sy * c[r.kz];
+    const auto shear = [](float s, float along, float across) { return std::fma(-s, along, across); };
+    const float ax = shear(r.sx, a[r.kz], a[r.kx]), ay = shear(r.sy, a[r.kz], a[r.ky]);
+    const float bx = shear(r.sx, b[r.kz], b[r.kx]), by = shear(r.sy, b[r.kz], b[r.ky]);
+    const float cx = shear(r.sx, c[r.kz], c[r.kx]), cy = shear(r.sy, c[r.kz], c[r.ky]);
     float u = cx * by - cy * bx;  // weight of v0
     float v = ax * cy - ay * cx;  // weight of v1
     float w = bx * ay - by * ax;  // weight of v2
@@ -78,16 +86,9 @@ struct WatertightTriangle {
     const float det = u + v + w;
     if (!(det != 0.0f)) return false;  // degenerate (or NaN)
     const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
-    const float t_scaled = u * az + v * bz + w * cz;
-    // tnear < t <= tmax, without dividing: the paper's sign-aware comparison.
-    if (det > 0.0f) {
-      if (!(t_scaled > r.tnear * det && t_scaled <= tmax * det)) return false;
-    } else {
-      if (!(t_scaled < r.tnear * det && t_scaled >= tmax * det)) return false;
-    }
+    const float t_scaled = std::fma(u, az, std::fma(v, bz, w * cz));
     const float inv_det = 1.0f / det;
     out = {t_scaled * inv_det, v * inv_det, w * inv_det};
-    // tmax * det may round: keep the exact interval on the divided t.
     return out.t > r.tnear && out.t <= tmax;
   }
   static bool intersect(const Ray& ray, float tmax, const Triangle& tri, TriangleHit& out) {

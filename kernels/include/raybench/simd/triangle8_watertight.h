@@ -42,9 +42,7 @@ struct alignas(32) TriangleVertices8 {
 
 // Lane by lane with the scalar test, every lane against the same tmax.
 // Returns the lane of the closest hit in (tnear, tmax], or -1; on equal t the
-// last such lane wins (as intersect_pack). Lowering tmax between lanes, as a
-// sequential loop would, is not the same: the test compares t_scaled with
-// tmax * det, whose rounding can reject a lane at exactly the same t.
+// last such lane wins (as intersect_pack).
 inline int intersect8_watertight_scalar(const WatertightTriangle::RayData& ray, float tmax, const TriangleVertices8& t,
                                         TriangleHit& out) {
   int best = -1;
@@ -69,34 +67,30 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
   __m256 x[3], y[3], z[3];
   for (int k = 0; k < 3; ++k) {
     z[k] = _mm256_sub_ps(_mm256_load_ps(t.v[k][r.kz]), oz);
-    x[k] = _mm256_sub_ps(_mm256_sub_ps(_mm256_load_ps(t.v[k][r.kx]), ox), _mm256_mul_ps(sx, z[k]));
-    y[k] = _mm256_sub_ps(_mm256_sub_ps(_mm256_load_ps(t.v[k][r.ky]), oy), _mm256_mul_ps(sy, z[k]));
+    x[k] = _mm256_fnmadd_ps(sx, z[k], _mm256_sub_ps(_mm256_load_ps(t.v[k][r.kx]), ox));
+    y[k] = _mm256_fnmadd_ps(sy, z[k], _mm256_sub_ps(_mm256_load_ps(t.v[k][r.ky]), oy));
   }
   const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
   const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
   const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
   const __m256 zero = _mm256_setzero_ps();
-  const __m256 any_negative = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_LT_OQ), _mm256_cmp_ps(v, zero, _CMP_LT_OQ)),
-                                           _mm256_cmp_ps(w, zero, _CMP_LT_OQ));
-  const __m256 any_positive = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_GT_OQ), _mm256_cmp_ps(v, zero, _CMP_GT_OQ)),
-                                           _mm256_cmp_ps(w, zero, _CMP_GT_OQ));
-  const __m256 outside = _mm256_and_ps(any_negative, any_positive);
+  // Outside: the smallest determinant negative and the largest positive.
+  // min/max return one of their operands, so this says outside only where
+  // the scalar test does; where a NaN hides a sign from them, det is NaN
+  // and the lane misses in both.
+  const __m256 smallest = _mm256_min_ps(_mm256_min_ps(u, v), w), largest = _mm256_max_ps(_mm256_max_ps(u, v), w);
+  const __m256 outside = _mm256_and_ps(_mm256_cmp_ps(smallest, zero, _CMP_LT_OQ), _mm256_cmp_ps(largest, zero, _CMP_GT_OQ));
   // Lanes on an edge in float and not already outside: the scalar test
   // decides them in double.
   const __m256 on_edge = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
                                       _mm256_cmp_ps(w, zero, _CMP_EQ_OQ));
   const int exact = _mm256_movemask_ps(_mm256_andnot_ps(outside, on_edge));
   const __m256 det = _mm256_add_ps(_mm256_add_ps(u, v), w);
-  const __m256 t_scaled = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(u, _mm256_mul_ps(sz, z[0])), _mm256_mul_ps(v, _mm256_mul_ps(sz, z[1]))),
-                                        _mm256_mul_ps(w, _mm256_mul_ps(sz, z[2])));
-  const __m256 lo = _mm256_mul_ps(_mm256_set1_ps(r.tnear), det), hi = _mm256_mul_ps(_mm256_set1_ps(tmax), det);
-  const __m256 positive = _mm256_cmp_ps(det, zero, _CMP_GT_OQ);
-  const __m256 in_positive = _mm256_and_ps(_mm256_cmp_ps(t_scaled, lo, _CMP_GT_OQ), _mm256_cmp_ps(t_scaled, hi, _CMP_LE_OQ));
-  const __m256 in_negative = _mm256_and_ps(_mm256_cmp_ps(t_scaled, lo, _CMP_LT_OQ), _mm256_cmp_ps(t_scaled, hi, _CMP_GE_OQ));
-  __m256 ok = _mm256_andnot_ps(outside, _mm256_cmp_ps(det, zero, _CMP_NEQ_OQ));
-  ok = _mm256_and_ps(ok, _mm256_blendv_ps(in_negative, in_positive, positive));
+  const __m256 t_scaled = _mm256_fmadd_ps(u, _mm256_mul_ps(sz, z[0]),
+                                          _mm256_fmadd_ps(v, _mm256_mul_ps(sz, z[1]), _mm256_mul_ps(w, _mm256_mul_ps(sz, z[2]))));
   const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
   const __m256 tt = _mm256_mul_ps(t_scaled, inv_det);
+  __m256 ok = _mm256_andnot_ps(outside, _mm256_cmp_ps(det, zero, _CMP_NEQ_OQ));
   ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(tt, _mm256_set1_ps(r.tnear), _CMP_GT_OQ),
                                        _mm256_cmp_ps(tt, _mm256_set1_ps(tmax), _CMP_LE_OQ)));
   int mask = _mm256_movemask_ps(ok) & ~exact;
