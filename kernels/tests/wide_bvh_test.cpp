@@ -469,7 +469,7 @@ TEST(WideBvhTraversal, AnyHitPushesTheEnteredChildrenInLaneOrderAboveWhatIsThere
   for (unsigned mask = 0; mask < 256; ++mask) {
     wide_bvh_detail::Stack<8> stack;
     stack.top = 3;
-    wide_bvh_detail::push_children_scalar<false>(stack, node, 0, mask, nullptr);
+    wide_bvh_detail::push_in_lane_order(stack, node, mask);
     ASSERT_EQ(stack.top, 3 + __builtin_popcount(mask)) << mask;
     for (int i = 3, lane = 0; i < stack.top; ++i, ++lane) {
       while (!(mask >> lane & 1u)) ++lane;

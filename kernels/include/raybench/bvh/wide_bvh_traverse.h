@@ -66,26 +66,32 @@ struct Stack {
   int top = 0;
 };
 
-// Pushes the children of `node` in `lanes` (bit i: lane i) in the node's
-// far-to-near order for `octant`, lane by lane: the scalar form of the
-// compacted SIMD push below, same order. With `ordered` false, in lane
-// order and without entry distances (any hit): the AVX2 traversal pushes
-// so too, as Embree does (bvh_traverser1.h), for the two or three children
-// a shadow ray usually enters: measured 3-7 % faster on shadow rays than
-// the compacted SIMD push.
+// Pushes the children of `node` in `lanes` (bit i: lane i) in lane order,
+// refs only (any hit: its interval never shrinks). The AVX2 traversal pushes
+// so too, as Embree does (bvh_traverser1.h): for the two or three children a
+// shadow ray usually enters, measured 3-7 % faster than a compacted SIMD push.
+template <int W>
+inline void push_in_lane_order(Stack<W>& stack, const WideNode<W>& node, unsigned lanes) {
+  for (; lanes; lanes &= lanes - 1) stack.ref[stack.top++] = node.child[__builtin_ctz(lanes)];
+}
+
+// Pushes the children of `node` in `lanes` in the node's far-to-near order
+// for `octant`, lane by lane, with their entry distances: the scalar form of
+// the compacted SIMD push below, same order. With `ordered` false, in lane
+// order and without entry distances (push_in_lane_order).
 template <bool Ordered, int W>
 inline void push_children_scalar(Stack<W>& stack, const WideNode<W>& node, int octant, unsigned lanes,
                                  const float entry[W]) {
   if constexpr (!Ordered) {
-    for (; lanes; lanes &= lanes - 1) stack.ref[stack.top++] = node.child[__builtin_ctz(lanes)];
-    return;
-  }
-  for (int rank = 0; rank < W; ++rank) {
-    const int lane = Ordered ? far_to_near_lane(node, octant, rank) : rank;
-    if (!(lanes >> lane & 1u)) continue;
-    stack.ref[stack.top] = node.child[lane];
-    if constexpr (Ordered) stack.entry[stack.top] = entry[lane];
-    ++stack.top;
+    push_in_lane_order(stack, node, lanes);
+  } else {
+    for (int rank = 0; rank < W; ++rank) {
+      const int lane = far_to_near_lane(node, octant, rank);
+      if (!(lanes >> lane & 1u)) continue;
+      stack.ref[stack.top] = node.child[lane];
+      stack.entry[stack.top] = entry[lane];
+      ++stack.top;
+    }
   }
 }
 
@@ -198,7 +204,7 @@ RAYBENCH_INLINE Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
         // In lane order; the highest lane entered is visited first.
         if (hit_lanes) {
           const int highest = 31 - __builtin_clz(hit_lanes);
-          wide_bvh_detail::push_children_scalar<false>(stack, node, octant, hit_lanes & ~(1u << highest), nullptr);
+          wide_bvh_detail::push_in_lane_order(stack, node, hit_lanes & ~(1u << highest));
           ref = node.child[highest];
           continue;
         }
