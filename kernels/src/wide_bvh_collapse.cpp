@@ -348,15 +348,14 @@ WideBvh<W> collapse_bvh2(const Bvh2& bvh2, std::span<const Triangle> triangles, 
   WideBvh<W> out;
   if (triangles.empty()) return out;  // no nodes: traversal returns at once
   Collapser<W>(bvh2, triangles, leaves, lane_order, out).run();
+  out.bounds = out.nodes[0].bounds.bounds();
   return out;
 }
 
 template <int W>
 double WideBvh<W>::sah_cost() const {
   if (nodes.empty()) return 0.0;
-  BBox root;
-  for (int lane = 0; lane < W; ++lane) root.extend(nodes[0].bounds.lane(lane));  // empty lanes add nothing
-  const double root_area = root.half_area();
+  const double root_area = bounds.half_area();
   if (!(root_area > 0.0)) return 0.0;
   double cost = root_area;  // the root is always visited
   for (const WideNode<W>& n : nodes)

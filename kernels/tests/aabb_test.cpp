@@ -6,6 +6,7 @@
 //   SlabSeed.KnownFailure_*   the seed note's bugs, pinned as documented behaviour
 //   Slab / SlabRobust         rounding: the unpadded test misses a box the exact
 //   / SlabRobustRay           ray touches, the padded ones never do
+//   SlabFmaRobust  the fused conservative test: never misses, answers within its margin
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -16,6 +17,7 @@
 #include "raybench/prim/aabb.h"
 #include "raybench/prim/aabb_slab.h"
 #include "raybench/prim/aabb_slab_fma.h"
+#include "raybench/prim/aabb_slab_fma_robust.h"
 #include "raybench/prim/aabb_slab_robust.h"
 #include "raybench/prim/aabb_slab_robust_ray.h"
 #include "raybench/prim/aabb_slab_seed.h"
@@ -465,7 +467,7 @@ TEST(SlabRobust, NeverMissesRaysAimedExactlyAtEdgesAndCorners) {
                               static_cast<std::int32_t>(range * 1024)) / 1024.0f;
   };
   constexpr int kRays = 100000;
-  int slab_misses = 0, robust_misses = 0, robust_ray_misses = 0;
+  int slab_misses = 0, robust_misses = 0, robust_ray_misses = 0, fused_misses = 0, fused_robust_misses = 0;
   for (int i = 0; i < kRays; ++i) {
     const Vec3f p{grid(16), grid(16), grid(16)}, q{grid(16), grid(16), grid(16)};
     const BBox b = box(min(p, q), max(p, q));
@@ -485,10 +487,130 @@ TEST(SlabRobust, NeverMissesRaysAimedExactlyAtEdgesAndCorners) {
     slab_misses += !hits<Slab>(r, b);
     robust_misses += !hits<SlabRobust>(r, b);
     robust_ray_misses += !hits<SlabRobustRay>(r, b);
+    fused_misses += !hits<SlabFma>(r, b);
+    fused_robust_misses += !hits<SlabFmaRobust>(r, b);
   }
   EXPECT_EQ(robust_misses, 0);
   EXPECT_EQ(robust_ray_misses, 0) << "SlabRobustRay, the padding folded into the ray";
+  EXPECT_EQ(fused_robust_misses, 0) << "SlabFmaRobust, the fused form with offsets";
   EXPECT_GT(slab_misses, kRays / 100);  // the set is hard: without padding > 1 % are lost
+  EXPECT_GT(fused_misses, kRays / 100);
+}
+
+// ---------------------------------------------------------------------------
+// SlabFmaRobust: the fused form, conservative by offsets set once per ray
+// over the extent of the planes (aabb_slab_fma_robust.h). Its entries may
+// lie below the exact ones by its margin, so it has its own specification
+// here rather than the exact entries of AllBoxTests.
+
+TEST(SlabFmaRobust, HitsTheCornerTheUnpaddedTestMissesByRounding) {
+  BoxHit h;
+  ASSERT_TRUE(hits<SlabFmaRobust>(kCornerGrazer, kUnit, &h));
+  EXPECT_LE(h.t_entry, 1.0f);
+  EXPECT_GE(h.t_exit, 1.0f);
+}
+
+TEST(SlabFmaRobust, WhereOTimesOneOverDIsExactTheOffsetsMoveEachDistanceByTheMarginAlone) {
+  // o = (-1, 0.5, 0.5), d = (1, 1, 1) against [0,2]x[0,1]x[0,1]: on x,
+  // o/d = -1 exactly and the planes reach 2, so the margin is
+  // (2 + 1) * 2^-21; the near distance 1 falls by it, the far one, 3, rises.
+  const BBox b = box({0, 0, 0}, {2, 1, 1});
+  const SlabFmaRobust::Offsets o = SlabFmaRobust::offsets(SlabFmaRobust::precompute(ray({-1, 0.5f, 0.5f}, {1, 1, 1})), b);
+  EXPECT_EQ(o.near.x, -1.0f + 3 * 0x1p-21f);
+  EXPECT_EQ(o.far.x, -1.0f - 3 * 0x1p-21f);
+  EXPECT_EQ(o.near.y, 0.5f + 1.5f * 0x1p-21f);  // planes up to 1, |o/d| = 0.5
+}
+
+TEST(SlabFmaRobust, ANegativeTnearNeedsNoFallback) {
+  // Unlike SlabRobustRay's scaled reciprocals, the offsets hold for
+  // distances of either sign: a box behind the origin (t in [-3, -2]),
+  // reached by tnear < 0.
+  BoxHit h;
+  ASSERT_TRUE(hits<SlabFmaRobust>(ray({3, 0.5f, 0.5f}, {1, 0.125f, 0.125f}, -3.0f, -2.0f), kUnit, &h));
+  EXPECT_LE(h.t_entry, -3.0f);
+  EXPECT_GE(h.t_exit, -2.0f);
+  EXPECT_FALSE(hits<SlabFmaRobust>(ray({3, 0.5f, 0.5f}, {1, 0.125f, 0.125f}, -1.0f, 0.0f), kUnit));
+}
+
+TEST(SlabFmaRobust, RaysWithAZeroComponentAreTestedAsSlabRobust) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-4, 4);
+  int hits_seen = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3f p{u(rng), u(rng), u(rng)}, q{u(rng), u(rng), u(rng)};
+    Vec3f d{u(rng), u(rng), u(rng)};
+    d[i % 3] = i % 2 ? 0.0f : -0.0f;
+    const Ray r = ray({u(rng), u(rng), u(rng)}, d, 0.0f, std::fabs(u(rng)));
+    BoxHit a, b;
+    const bool hit = hits<SlabFmaRobust>(r, box(min(p, q), max(p, q)), &a);
+    ASSERT_EQ(hit, hits<SlabRobust>(r, box(min(p, q), max(p, q)), &b)) << "ray " << i;
+    if (hit) {
+      EXPECT_EQ(a.t_entry, b.t_entry);
+      EXPECT_EQ(a.t_exit, b.t_exit);
+      ++hits_seen;
+    }
+  }
+  EXPECT_GT(hits_seen, 500);
+}
+
+TEST(SlabFmaRobust, NanAnywhereInTheRayMisses) {
+  for (int axis = 0; axis < 3; ++axis) {
+    Ray r = ray({-1, 0.5f, 0.5f}, {1, 0.25f, 0.25f});
+    r.org[axis] = kNaN;
+    EXPECT_FALSE(hits<SlabFmaRobust>(r, kUnit)) << "org " << axis;
+    r = ray({-1, 0.5f, 0.5f}, {1, 0.25f, 0.25f});
+    r.dir[axis] = kNaN;
+    EXPECT_FALSE(hits<SlabFmaRobust>(r, kUnit)) << "dir " << axis;
+  }
+  EXPECT_FALSE(hits<SlabFmaRobust>(ray({-1, 0.5f, 0.5f}, {1, 0.25f, 0.25f}, kNaN), kUnit));
+  EXPECT_FALSE(hits<SlabFmaRobust>(ray({-1, 0.5f, 0.5f}, {1, 0.25f, 0.25f}, 0.0f, kNaN), kUnit));
+  EXPECT_FALSE(hits<SlabFmaRobust>(ray({-1, 0.5f, 0.5f}, {1, 0.25f, 0.25f}), BBox{}));  // the empty box
+}
+
+TEST(SlabFmaRobust, EntryNeverAboveTheExactEntryNorExitBelowTheExactExitAndBothWithinTheMargin) {
+  // Random boxes and rays at several scales and origins up to 10^4 box
+  // sizes away, tnear of either sign, tmax finite or not, against distances
+  // computed in double (exact to 2^-52). Q = max over axes of
+  // (largest |plane| + |o|) / |d| bounds the margin, 8u Q, and the
+  // rounding, so the answers may move by at most 2^-20 Q.
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<float> u(-1, 1);
+  int hits_seen = 0;
+  for (int i = 0; i < 50000; ++i) {
+    const float scale = std::ldexp(1.0f, static_cast<int>(rng() % 21) - 10);
+    const float away = scale * std::ldexp(1.0f, static_cast<int>(rng() % 14));
+    const Vec3f p{u(rng) * scale, u(rng) * scale, u(rng) * scale}, q{u(rng) * scale, u(rng) * scale, u(rng) * scale};
+    const BBox b = box(min(p, q), max(p, q));
+    const Vec3f o{u(rng) * away, u(rng) * away, u(rng) * away};
+    const Vec3f target{u(rng) * scale, u(rng) * scale, u(rng) * scale};
+    const float tnear = i % 3 == 0 ? -std::fabs(u(rng)) : 0.0f;
+    const float tmax = i % 4 == 0 ? 0.25f + std::fabs(u(rng)) : kInf;
+    const Ray r = ray(o, target - o, tnear, tmax);
+    double a = tnear, z = tmax, largest = 0.0;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double d = r.dir[axis], lo = b.lower[axis], hi = b.upper[axis];
+      ASSERT_NE(d, 0.0);
+      const double t_lo = (lo - o[axis]) / d, t_hi = (hi - o[axis]) / d;
+      a = std::max(a, std::min(t_lo, t_hi));
+      z = std::min(z, std::max(t_lo, t_hi));
+      largest = std::max(largest, (std::max(std::fabs(lo), std::fabs(hi)) + std::fabs(o[axis])) / std::fabs(d));
+    }
+    const double slack = largest * 0x1p-20, roundoff = largest * 0x1p-40;
+    BoxHit h;
+    const bool hit = hits<SlabFmaRobust>(r, b, &h);
+    if (a <= z) {
+      ASSERT_TRUE(hit) << "ray " << i << ": the exact ray touches the box";
+    }
+    if (!hit) continue;
+    ++hits_seen;
+    EXPECT_LE(h.t_entry, a + roundoff) << "ray " << i;
+    EXPECT_GE(h.t_entry, a - slack) << "ray " << i;
+    EXPECT_GE(h.t_exit, z - roundoff) << "ray " << i;
+    if (z < kInf) {
+      EXPECT_LE(h.t_exit, z + slack + std::fabs(z) * 0x1p-20) << "ray " << i;  // the margin, or tmax's pad
+    }
+  }
+  EXPECT_GT(hits_seen, 5000);
 }
 
 // ---------------------------------------------------------------------------

@@ -101,10 +101,16 @@ TEST_P(WideBvhBuild, EveryTriangleInALeafUnderBoundsThatContainItOrTogetherCover
     const auto tris = random_soup(n, 1);
     const auto bvh = build<width()>(tris);
     std::vector<std::vector<BBox>> leaves_of(tris.size());
-    BBox everything;
-    everything.extend(Vec3f{-1e9f, -1e9f, -1e9f});
-    everything.extend(Vec3f{1e9f, 1e9f, 1e9f});
-    check(bvh, tris, 0, everything, splits, leaves_of);
+    // Every box lies within the tree's bounds: the extent SlabFmaRobust's
+    // margins are computed over (a plane outside it could be missed).
+    check(bvh, tris, 0, bvh.bounds, splits, leaves_of);
+    BBox soup;
+    for (const Triangle& t : tris) {
+      soup.extend(t.v0);
+      soup.extend(t.v1);
+      soup.extend(t.v2);
+    }
+    EXPECT_TRUE(bvh.bounds.contains(soup));
     for (std::size_t i = 0; i < tris.size(); ++i) {
       if (!splits) {
         EXPECT_EQ(leaves_of[i].size(), 1u) << "triangle " << i << " of " << tris.size();
@@ -231,6 +237,7 @@ TEST_P(WideBvhBuild, WatertightLeavesMatchTheScalarWatertightTestOnEveryRayKind)
     expect_watertight_leaves_match_brute_force<Slab>(bvh, tris, rays);
     expect_watertight_leaves_match_brute_force<SlabRobust>(bvh, tris, rays);
     expect_watertight_leaves_match_brute_force<SlabRobustRay>(bvh, tris, rays);
+    expect_watertight_leaves_match_brute_force<SlabFmaRobust>(bvh, tris, rays);
   }
 }
 
@@ -242,7 +249,7 @@ TEST_P(WideBvhBuild, WatertightRobustTraversalLeaksNoRayAimedAtEdgesAndVerticesF
   const Bvh8 bvh = collapse_bvh2<8>(build_bvh2(tris, GetParam(), options), tris, WideLeaves::kVertices);
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(-0.5f, 0.5f), s(0, 1);
-  int leaks = 0, leaks_ray_padded = 0;
+  int leaks = 0, leaks_ray_padded = 0, leaks_fused = 0;
   for (int i = 0; i < 6000; ++i) {
     const Triangle& t = tris[static_cast<std::size_t>(i) * 7919 % tris.size()];
     const Vec3f target = i % 2 ? t.v1 : t.v0 + (t.v2 - t.v0) * s(rng);  // a vertex, or a float point of an edge
@@ -250,9 +257,11 @@ TEST_P(WideBvhBuild, WatertightRobustTraversalLeaksNoRayAimedAtEdgesAndVerticesF
     const Ray ray{org, 0.0f, target - org, kInf};
     leaks += !intersect_wide<Bvh8Watertight, SlabRobust>(bvh, ray).hit();
     leaks_ray_padded += !intersect_wide<Bvh8Watertight, SlabRobustRay>(bvh, ray).hit();
+    leaks_fused += !intersect_wide<Bvh8Watertight, SlabFmaRobust>(bvh, ray).hit();
   }
   EXPECT_EQ(leaks, 0);
   EXPECT_EQ(leaks_ray_padded, 0);
+  EXPECT_EQ(leaks_fused, 0);
 }
 
 TEST_P(WideBvhBuild, FindsTheClosedSphereFromInsideAndNothingOutsideIt) {
@@ -298,6 +307,7 @@ TEST_P(WideBvhBuild, EmptyInputBuildsATreeThatNothingHits) {
     const auto bvh = build<width()>(none);
     EXPECT_FALSE(intersect_wide(bvh, Ray{{0, 0, 0}, 0.0f, {0, 0, 1}, kInf}).hit());
     EXPECT_FALSE(occluded_wide(bvh, Ray{{0, 0, 0}, 0.0f, {0, 0, 1}, kInf}));
+    EXPECT_TRUE(bvh.bounds.empty());
   });
 }
 

@@ -143,6 +143,9 @@ TEST(Box8, Avx2AnswersExactlyAsTheScalarRobustRaySlabTest) { expect_boxes_simd_e
 TEST(Box4, SseAnswersExactlyAsTheScalarRobustRaySlabTest) { expect_boxes_simd_equals_scalar<SlabRobustRay, 4>(); }
 TEST(Box8, Avx2AnswersExactlyAsTheScalarFusedSlabTest) { expect_boxes_simd_equals_scalar<SlabFma, 8>(); }
 TEST(Box4, SseAnswersExactlyAsTheScalarFusedSlabTest) { expect_boxes_simd_equals_scalar<SlabFma, 4>(); }
+// Both forms set SlabFmaRobust's offsets from the W boxes' union.
+TEST(Box8, Avx2AnswersExactlyAsTheScalarFusedRobustSlabTest) { expect_boxes_simd_equals_scalar<SlabFmaRobust, 8>(); }
+TEST(Box4, SseAnswersExactlyAsTheScalarFusedRobustSlabTest) { expect_boxes_simd_equals_scalar<SlabFmaRobust, 4>(); }
 
 TEST(Watertight8, Avx2AnswersExactlyAsTheScalarWoopTestEvenThroughEdgesAndVertices) {
   expect_simd_answers_as_scalar<TriangleVertices8>(

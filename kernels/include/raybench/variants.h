@@ -8,6 +8,7 @@
 
 #include "raybench/prim/aabb_slab.h"
 #include "raybench/prim/aabb_slab_fma.h"
+#include "raybench/prim/aabb_slab_fma_robust.h"
 #include "raybench/prim/aabb_slab_robust.h"
 #include "raybench/prim/aabb_slab_robust_ray.h"
 #include "raybench/prim/aabb_slab_seed.h"
@@ -33,7 +34,7 @@ using TriangleTests =
 
 // Ray-box tests (seed 000), ray-sphere tests (seed 003), ray-OBB tests
 // (seed 004). The microbenchmarks (raybench kernels) time every entry.
-using BoxTests = std::tuple<Slab, SlabSeed, SlabRobust, SlabRobustRay, SlabFma>;
+using BoxTests = std::tuple<Slab, SlabSeed, SlabRobust, SlabRobustRay, SlabFma, SlabFmaRobust>;
 using SphereTests = std::tuple<SpherePrecise, SphereSeed, SphereQuadratic>;
 using ObbTests = std::tuple<Obb, ObbSeed>;
 

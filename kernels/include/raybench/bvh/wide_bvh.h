@@ -82,6 +82,9 @@ struct WideBvh {
   HugePageVector<TriangleVertices8> vertex_packs;  // WideLeaves::kVertices (W = 8): the same packs as vertices
   HugePageVector<std::int32_t> pack_prims;         // W per pack: input triangle index, -1 in unused lanes
   std::size_t depth = 0;                        // levels below the root; bounds the traversal stack
+  // The union of the root's child boxes, which contain every box below them:
+  // the extent of every plane a ray is tested against (SlabFmaRobust's).
+  BBox bounds;
 
   std::size_t memory_bytes() const {
     return nodes.size() * sizeof(WideNode<W>) + packs.size() * sizeof(TrianglePack<W>) +

@@ -37,7 +37,9 @@
 // backends' plain test: one fused multiply-add per plane, as Embree's),
 // Slab, or a conservative test (with the watertight leaves no ray leaks
 // through the tree, as bvh2:watertight:robust): SlabRobust pads every exit,
-// SlabRobustRay folds the padding into the ray (the backends' choice).
+// SlabRobustRay folds the padding into the ray, SlabFmaRobust into per-ray
+// offsets of the fused form (the backends' choice: it reads the tree's
+// bounds, the extent of every plane tested).
 #pragma once
 
 #include <array>
@@ -158,19 +160,21 @@ RAYBENCH_INLINE Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
   if (bvh.nodes.empty()) return hit;
   const Slab::Precomputed r = Slab::precompute(ray);
   // SlabFma serves rays with no zero direction component (the others take
-  // Slab, exact for them), SlabRobustRay rays with tnear >= 0 (the others
-  // pad every exit): the whole traversal runs with the test the ray gets.
+  // Slab, exact for them), SlabFmaRobust too (the others take SlabRobust),
+  // SlabRobustRay rays with tnear >= 0 (the others pad every exit): the
+  // whole traversal runs with the test the ray gets.
   if constexpr (HasFallback<BoxTest>)
     if (!BoxTest::serves(r)) return traverse_wide<AnyHit, Leaf, typename BoxTest::Fallback>(bvh, ray);
   const int octant = ray_octant(r);
 #if defined(__AVX2__)
-  const RayLanes<W> ray_lanes = RayLanes<W>::template from<BoxTest>(r);
+  const RayLanes<W> ray_lanes = RayLanes<W>::template from<BoxTest>(r, bvh.bounds);
 #endif
   const typename Leaf::RayData leaf_ray = Leaf::precompute(ray);
-  // A popped subtree farther than the current hit is skipped; the robust
-  // test compares with the padded bound, so it never skips what it entered.
+  // A popped subtree farther than the current hit is skipped; a
+  // conservative test compares with the padded bound (each pads tmax or
+  // every exit by SlabRobust's 8u), so it never skips what it entered.
   const auto reachable = [](float entry, float tmax) {
-    if constexpr (std::is_same_v<BoxTest, SlabRobust> || std::is_same_v<BoxTest, SlabRobustRay>)
+    if constexpr (BoxTest::accuracy == AccuracyClass::kConservative)
       return entry <= SlabRobust::padded(tmax);
     else return entry <= tmax;
   };

@@ -6,7 +6,9 @@
 // prim/aabb_slab_robust.h (Ize 2013): no box the exact ray touches is missed;
 // with SlabRobustRay the same guarantee comes from reciprocals scaled once
 // per ray (prim/aabb_slab_robust_ray.h), no padding per box; with SlabFma
-// each distance is one fused multiply-add (prim/aabb_slab_fma.h).
+// each distance is one fused multiply-add (prim/aabb_slab_fma.h), and with
+// SlabFmaRobust so too, conservative by offsets set once per ray
+// (prim/aabb_slab_fma_robust.h).
 // AVX2 (8 lanes) or SSE (4 lanes) when the compiler targets AVX2, else a
 // scalar loop, same answers.
 #pragma once
@@ -20,6 +22,7 @@
 #include "raybench/math/inline.h"
 #include "raybench/prim/aabb_slab.h"
 #include "raybench/prim/aabb_slab_fma.h"
+#include "raybench/prim/aabb_slab_fma_robust.h"
 #include "raybench/prim/aabb_slab_robust.h"
 #include "raybench/prim/aabb_slab_robust_ray.h"
 #include "raybench/simd/lanes.h"
@@ -45,6 +48,13 @@ struct alignas(4 * W) BBoxWide {
     return p;
   }
 
+  // The union of the W boxes (empty lanes add nothing).
+  BBox bounds() const {
+    BBox all;
+    for (int i = 0; i < W; ++i) all.extend(lane(i));
+    return all;
+  }
+
   BBox lane(int i) const {
     BBox box;
     for (int a = 0; a < 3; ++a) {
@@ -57,25 +67,36 @@ struct alignas(4 * W) BBoxWide {
 using BBox8 = BBoxWide<8>;
 using BBox4 = BBoxWide<4>;
 
+// A box test that serves only some rays (SlabFma, SlabFmaRobust: no zero
+// direction component; SlabRobustRay: tnear >= 0) names the test the others get:
+// BoxTest::Fallback when !BoxTest::serves(r). Callers pick it once per ray.
+template <typename BoxTest>
+concept HasFallback = requires { typename BoxTest::Fallback; };
+
 // Bit i set when box i is entered within [tnear, tmax]; entry[i] its entry
-// distance (+inf for a missed box). The scalar form: box by box.
+// distance (+inf for a missed box). The scalar form: box by box. A test
+// that needs the extent of the planes (SlabFmaRobust) gets the W boxes' union.
 template <typename BoxTest = Slab, int W>
 inline unsigned intersect_boxes_scalar(const Slab::Precomputed& r, float tmax, const BBoxWide<W>& b, float entry[W]) {
+  if constexpr (HasFallback<BoxTest>)
+    if (!BoxTest::serves(r)) return intersect_boxes_scalar<typename BoxTest::Fallback>(r, tmax, b, entry);
   unsigned mask = 0;
+  [[maybe_unused]] SlabFmaRobust::Offsets offsets;
+  if constexpr (UsesExtent<BoxTest>) offsets = BoxTest::offsets(r, b.bounds());
   for (int lane = 0; lane < W; ++lane) {
     BoxHit h;
-    const bool hit = BoxTest::intersect(r, b.lane(lane), tmax, h);
+    bool hit;
+    if constexpr (UsesExtent<BoxTest>) {
+      h = BoxTest::clip(r, offsets, b.lane(lane), tmax);
+      hit = Slab::overlaps(h);
+    } else {
+      hit = BoxTest::intersect(r, b.lane(lane), tmax, h);
+    }
     entry[lane] = hit ? h.t_entry : std::numeric_limits<float>::infinity();
     mask |= static_cast<unsigned>(hit) << lane;
   }
   return mask;
 }
-
-// A box test that serves only some rays (SlabFma: no zero direction
-// component; SlabRobustRay: tnear >= 0) names the test the others get:
-// BoxTest::Fallback when !BoxTest::serves(r). Callers pick it once per ray.
-template <typename BoxTest>
-concept HasFallback = requires { typename BoxTest::Fallback; };
 
 #if defined(__AVX2__)
 // The SIMD test with its answers left in registers for the traversal to
@@ -90,17 +111,28 @@ struct BoxHits {
 // o/d broadcast to every lane, and where each axis's entry planes lie in a
 // BBoxWide (lower, or upper for a negative 1/d), so a node's test is loads
 // and arithmetic only. far_inv_dir is what the far planes' distances are
-// scaled by: 1/d, or SlabRobustRay's 1/d rounded outward.
+// scaled by: 1/d, or SlabRobustRay's 1/d rounded outward; fused_near and
+// fused_far what the fused distances subtract: o/d, or SlabFmaRobust's
+// offsets, which need the extent of every plane the ray will be tested
+// against (a BVH's root bounds).
 template <int W>
 struct RayLanes {
-  simd::FloatLanes<W> org[3], inv_dir[3], far_inv_dir[3], org_over_dir[3];
+  simd::FloatLanes<W> org[3], inv_dir[3], far_inv_dir[3], fused_near[3], fused_far[3];
   int near_offset[3];  // from b.lower[a] to axis a's entry planes: 0 (lower) or 3W (upper)
   float tnear;
 
   template <typename BoxTest = Slab>
+    requires(!UsesExtent<BoxTest>)
   RAYBENCH_INLINE static RayLanes from(const Slab::Precomputed& r) {
+    return from<BoxTest>(r, BBox{});
+  }
+
+  template <typename BoxTest = Slab>
+  RAYBENCH_INLINE static RayLanes from(const Slab::Precomputed& r, [[maybe_unused]] const BBox& extent) {
     using F = simd::FloatLanes<W>;
     RayLanes lanes;
+    [[maybe_unused]] SlabFmaRobust::Offsets offsets;
+    if constexpr (UsesExtent<BoxTest>) offsets = BoxTest::offsets(r, extent);
     for (int a = 0; a < 3; ++a) {
       lanes.org[a] = F::set1(r.org[a]);
       lanes.inv_dir[a] = F::set1(r.inv_dir[a]);
@@ -108,7 +140,12 @@ struct RayLanes {
         lanes.far_inv_dir[a] = F::set1(SlabRobustRay::far_inv_dir(r.inv_dir[a]));
       else
         lanes.far_inv_dir[a] = lanes.inv_dir[a];
-      lanes.org_over_dir[a] = F::set1(r.org[a] * r.inv_dir[a]);
+      if constexpr (UsesExtent<BoxTest>) {
+        lanes.fused_near[a] = F::set1(offsets.near[a]);
+        lanes.fused_far[a] = F::set1(offsets.far[a]);
+      } else {
+        lanes.fused_near[a] = lanes.fused_far[a] = F::set1(r.org[a] * r.inv_dir[a]);
+      }
       lanes.near_offset[a] = r.negative[a] ? 3 * W : 0;
     }
     lanes.tnear = r.tnear;
@@ -116,23 +153,24 @@ struct RayLanes {
   }
 };
 
-// With BoxTest = SlabFma each distance is one fused multiply-add; the
-// caller has checked SlabFma::serves(r) (every 1/d finite), as
-// intersect_boxes_simd and traverse_wide do once per ray.
+// With BoxTest = SlabFma or SlabFmaRobust each distance is one fused
+// multiply-add; the caller has checked BoxTest::serves(r) (every 1/d
+// finite), as intersect_boxes_simd and traverse_wide do once per ray.
 template <typename BoxTest = Slab, int W>
 RAYBENCH_INLINE BoxHits<W> slab_lanes(const RayLanes<W>& r, float tmax, const BBoxWide<W>& b) {
   using F = simd::FloatLanes<W>;
   constexpr bool kRobust = std::is_same_v<BoxTest, SlabRobust>;
-  constexpr bool kRobustRay = std::is_same_v<BoxTest, SlabRobustRay>;
+  constexpr bool kPadsTmax = std::is_same_v<BoxTest, SlabRobustRay> || std::is_same_v<BoxTest, SlabFmaRobust>;
+  constexpr bool kFused = std::is_same_v<BoxTest, SlabFma> || std::is_same_v<BoxTest, SlabFmaRobust>;
   constexpr float kLargest = std::numeric_limits<float>::max();
   // Slab::overlaps asks entry <= exit and entry < +inf (an entry at +inf is
   // never reached). With the exit clamped to the largest float, entry <=
   // exit says both: one comparison per node instead of two and an and. The
   // clamp goes on tmax (std::min keeps a NaN tmax NaN, a miss), or, for the
   // robust test, on the padded exit, which may round up to +inf.
-  // SlabRobustRay pads tmax (a NaN tmax stays NaN through std::min, a miss);
-  // its far distances come padded from far_inv_dir.
-  const float exit_bound = kRobustRay ? std::min(SlabRobust::padded(tmax), kLargest)
+  // SlabRobustRay and SlabFmaRobust pad tmax (a NaN tmax stays NaN through
+  // std::min, a miss); their far distances come padded from far_inv_dir or fused_far.
+  const float exit_bound = kPadsTmax ? std::min(SlabRobust::padded(tmax), kLargest)
                            : kRobust  ? tmax
                                       : std::min(tmax, kLargest);
   F t_entry = F::set1(r.tnear), t_exit = F::set1(exit_bound);
@@ -145,9 +183,9 @@ RAYBENCH_INLINE BoxHits<W> slab_lanes(const RayLanes<W>& r, float tmax, const BB
     // max/min return their second operand when either is NaN: a NaN
     // distance keeps the bound and a NaN bound stays NaN, exactly as
     // Slab::clip's comparisons do.
-    if constexpr (std::is_same_v<BoxTest, SlabFma>) {
-      t_entry = max(fmsub(near_plane, r.inv_dir[a], r.org_over_dir[a]), t_entry);
-      t_exit = min(fmsub(far_plane, r.inv_dir[a], r.org_over_dir[a]), t_exit);
+    if constexpr (kFused) {
+      t_entry = max(fmsub(near_plane, r.inv_dir[a], r.fused_near[a]), t_entry);
+      t_exit = min(fmsub(far_plane, r.inv_dir[a], r.fused_far[a]), t_exit);
     } else {
       t_entry = max((near_plane - r.org[a]) * r.inv_dir[a], t_entry);
       t_exit = min((far_plane - r.org[a]) * r.far_inv_dir[a], t_exit);
@@ -165,7 +203,7 @@ template <typename BoxTest = Slab, int W>
 inline unsigned intersect_boxes_simd(const Slab::Precomputed& r, float tmax, const BBoxWide<W>& b, float entry[W]) {
   if constexpr (HasFallback<BoxTest>)
     if (!BoxTest::serves(r)) return intersect_boxes_simd<typename BoxTest::Fallback>(r, tmax, b, entry);
-  const BoxHits<W> h = slab_lanes<BoxTest>(RayLanes<W>::template from<BoxTest>(r), tmax, b);
+  const BoxHits<W> h = slab_lanes<BoxTest>(RayLanes<W>::template from<BoxTest>(r, b.bounds()), tmax, b);
   alignas(32) float t[W];
   h.t_entry.storeu(t);
   const unsigned mask = h.hit.mask();
