@@ -37,9 +37,10 @@
 // backends' plain test: one fused multiply-add per plane, as Embree's),
 // Slab, or a conservative test (with the watertight leaves no ray leaks
 // through the tree, as bvh2:watertight:robust): SlabRobust pads every exit,
-// SlabRobustRay folds the padding into the ray, SlabFmaRobust into per-ray
-// offsets of the fused form (the backends' choice: it reads the tree's
-// bounds, the extent of every plane tested).
+// SlabRobustRay folds the padding into the ray (the backends' choice),
+// SlabFmaRobust into per-ray offsets of the fused form (it reads the tree's
+// bounds, the extent of every plane tested; measured slower here, see
+// prim/aabb_slab_fma_robust.h).
 #pragma once
 
 #include <array>
@@ -143,7 +144,7 @@ struct WideMollerTrumbore {
 struct Bvh8Watertight {
   static constexpr WideLeaves kLeaves = WideLeaves::kVertices;
   using RayData = WatertightTriangle::RayData;
-  static RayData precompute(const Ray& ray) { return WatertightTriangle::precompute(ray); }
+  RAYBENCH_INLINE static RayData precompute(const Ray& ray) { return WatertightTriangle::precompute(ray); }
   RAYBENCH_INLINE static int intersect(const RayData& ray, float tmax, const Bvh8& bvh, std::uint32_t pack, TriangleHit& out) {
     return intersect8_watertight(ray, tmax, bvh.vertex_packs[pack], out);
   }

@@ -23,6 +23,7 @@
 #include <cmath>
 #include <string_view>
 
+#include "raybench/math/inline.h"
 #include "raybench/math/ray.h"
 #include "raybench/prim/triangle.h"
 
@@ -42,7 +43,7 @@ struct WatertightTriangle {
     int kx, ky, kz;
     float sx, sy, sz;
   };
-  static RayData precompute(const Ray& ray) {
+  RAYBENCH_INLINE static RayData precompute(const Ray& ray) {
     RayData r;
     r.org = ray.org;
     r.tnear = ray.tnear;
