@@ -5,8 +5,8 @@
 //   a triangle test: mt (Möller–Trumbore in its stored-normal form,
 //     prim/triangle_mt_normal.h, simd/wide_triangle.h; the default)
 //     or, 8 wide only, watertight (Woop et al. 2013, simd/triangle8_watertight.h);
-//   robust: the conservative wide box test (the fused form with its
-//     padding in per-ray offsets, prim/aabb_slab_fma_robust.h), so that
+//   robust: the conservative wide box test (Ize's padding folded into the
+//     ray, prim/aabb_slab_robust_ray.h), so that
 //     bvh8:watertight:robust leaks no ray through the tree either; without
 //     it, SlabFma (prim/aabb_slab_fma.h: one fused multiply-add per plane);
 //   a builder from raybench/bvh/bvh2_builders.h ("bvh8:sweep", "bvh4:lbvh");
@@ -83,7 +83,7 @@ class WideBvhBackend final : public Backend {
 template <int W, typename Leaf>
 std::unique_ptr<Backend> make_with_box_test(const std::string& name, Bvh2Builder builder, int reinsertion_passes,
                                             bool robust) {
-  if (robust) return std::make_unique<WideBvhBackend<W, Leaf, SlabFmaRobust>>(name, builder, reinsertion_passes);
+  if (robust) return std::make_unique<WideBvhBackend<W, Leaf, SlabRobustRay>>(name, builder, reinsertion_passes);
   return std::make_unique<WideBvhBackend<W, Leaf, SlabFma>>(name, builder, reinsertion_passes);
 }
 
@@ -124,10 +124,10 @@ std::vector<BackendInfo> wide_backend_names() {
     out.push_back(
         {"bvh8:watertight", "bvh8 with 8-wide watertight leaves (Woop, Benthin & Wald 2013) [watertight]", "watertight"});
     out.push_back({"bvh8:watertight:robust",
-                   "bvh8:<test>:robust traverses with the conservative 8-wide box test (slab_fma_robust): no ray leaks through the tree",
+                   "bvh8:<test>:robust traverses with the conservative 8-wide box test (slab_robust_ray): no ray leaks through the tree",
                    "watertight"});
   } else {
-    out.push_back({family + ":robust", fmt::format("{} with the conservative {}-wide box test (slab_fma_robust)", family, W)});
+    out.push_back({family + ":robust", fmt::format("{} with the conservative {}-wide box test (slab_robust_ray)", family, W)});
   }
   return out;
 }

@@ -2,14 +2,16 @@
 // multiply-add, as SlabFma (aabb_slab_fma.h), and yet, as SlabRobust
 // (aabb_slab_robust.h), it never misses a box that the exact ray (the float
 // inputs taken as exact reals) touches within [tnear, tmax]. All its padding
-// is in two offsets per axis, computed once per ray: the robust traversal of
-// the wide BVHs (bvh8:watertight:robust) tests every child box this way.
-// Measured against SlabRobustRay (Ize's reciprocals scaled once per ray, a
-// subtraction and a multiplication per plane), in one process, two runs,
-// watertight leaves, SBVH with reinsertion, bunny and Sponza-Dabrovic:
-// diffuse rays 0-8 % and shadow rays 10-13 % faster, and 2-8 % slower than
-// the unpadded SlabFma (three more constants per ray in registers: moving
-// the margin into one add per node instead measured slower still).
+// is in two offsets per axis, computed once per ray, so a box costs what
+// SlabFma's costs. The wide BVH traversal takes it as its box-test policy
+// (wide_bvh_traverse.h), but the backends' :robust option keeps
+// SlabRobustRay: in the benchmark, watertight leaves, SBVH with reinsertion,
+// this test was 15 % slower on the bunny's primary rays and 11 % on
+// Sponza-Dabrovic's shadow rays, where SlabRobustRay cost nothing against
+// the unpadded SlabFma; the per-ray offsets and three more constants held
+// through the traversal cost more than the subtraction per plane they save.
+// (An isolated one-process experiment had measured the opposite, 10-13 %
+// faster on shadow rays: code generation in the whole traversal decides.)
 //
 // Why SlabFma is not conservative: its distance plane * r - p, r = fl(1/d),
 // carries the rounding of p = fl(o * r), an error absolute in t (u |o / d|,
