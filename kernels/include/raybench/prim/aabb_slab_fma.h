@@ -43,13 +43,20 @@ struct SlabFma {
 
   RAYBENCH_INLINE static BoxHit clip(const Precomputed& r, const BBox& box, float tmax) {
     if (!serves(r)) return Fallback::clip(r, box, tmax);
+    const Vec3f org_over_dir{r.org.x * r.inv_dir.x, r.org.y * r.inv_dir.y, r.org.z * r.inv_dir.z};
+    return clip(r, org_over_dir, org_over_dir, box, tmax);
+  }
+  // As above with what the fused distances subtract given per axis: near
+  // planes t = plane * (1/d) - near[axis], far planes - far[axis]. Here both
+  // are o * (1/d); SlabFmaRobust moves them apart (aabb_slab_fma_robust.h).
+  RAYBENCH_INLINE static BoxHit clip(const Precomputed& r, const Vec3f& near, const Vec3f& far, const BBox& box,
+                                     float tmax) {
     float entry = r.tnear, exit = tmax;
     for (int axis = 0; axis < 3; ++axis) {
       const float near_plane = r.negative[axis] ? box.upper[axis] : box.lower[axis];
       const float far_plane = r.negative[axis] ? box.lower[axis] : box.upper[axis];
-      const float org_over_dir = r.org[axis] * r.inv_dir[axis];
-      const float t_near = std::fma(near_plane, r.inv_dir[axis], -org_over_dir);
-      const float t_far = std::fma(far_plane, r.inv_dir[axis], -org_over_dir);
+      const float t_near = std::fma(near_plane, r.inv_dir[axis], -near[axis]);
+      const float t_far = std::fma(far_plane, r.inv_dir[axis], -far[axis]);
       // As Slab::clip: a NaN distance (a NaN plane) is ignored, a NaN bound stays NaN.
       entry = t_near > entry ? t_near : entry;
       exit = t_far < exit ? t_far : exit;

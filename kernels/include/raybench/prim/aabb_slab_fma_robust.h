@@ -105,17 +105,7 @@ struct SlabFmaRobust {
   // On a hit, t_entry and t_exit are as computed: the entry may lie below
   // the exact entry and the exit above the exact exit by the margin.
   RAYBENCH_INLINE static BoxHit clip(const Precomputed& r, const Offsets& o, const BBox& box, float tmax) {
-    float entry = r.tnear, exit = SlabRobust::padded(tmax);
-    for (int axis = 0; axis < 3; ++axis) {
-      const float near_plane = r.negative[axis] ? box.upper[axis] : box.lower[axis];
-      const float far_plane = r.negative[axis] ? box.lower[axis] : box.upper[axis];
-      const float t_near = std::fma(near_plane, r.inv_dir[axis], -o.near[axis]);
-      const float t_far = std::fma(far_plane, r.inv_dir[axis], -o.far[axis]);
-      // As Slab::clip: a NaN distance (a NaN plane) is ignored, a NaN bound stays NaN.
-      entry = t_near > entry ? t_near : entry;
-      exit = t_far < exit ? t_far : exit;
-    }
-    return {entry, exit};
+    return SlabFma::clip(r, o.near, o.far, box, SlabRobust::padded(tmax));
   }
 
   RAYBENCH_INLINE static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
