@@ -110,7 +110,12 @@ struct SlabFmaRobust {
 
   RAYBENCH_INLINE static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
     if (!serves(ray)) return Fallback::intersect(ray, box, tmax, out);
-    const BoxHit h = clip(ray, offsets(ray, box), box, tmax);
+    return intersect(ray, offsets(ray, box), box, tmax, out);
+  }
+  // With offsets set over an extent that contains the box, for a ray it serves.
+  RAYBENCH_INLINE static bool intersect(const Precomputed& ray, const Offsets& o, const BBox& box, float tmax,
+                                        BoxHit& out) {
+    const BoxHit h = clip(ray, o, box, tmax);
     if (!Slab::overlaps(h)) return false;
     out = h;
     return true;

@@ -86,12 +86,8 @@ inline unsigned intersect_boxes_scalar(const Slab::Precomputed& r, float tmax, c
   for (int lane = 0; lane < W; ++lane) {
     BoxHit h;
     bool hit;
-    if constexpr (UsesExtent<BoxTest>) {
-      h = BoxTest::clip(r, offsets, b.lane(lane), tmax);
-      hit = Slab::overlaps(h);
-    } else {
-      hit = BoxTest::intersect(r, b.lane(lane), tmax, h);
-    }
+    if constexpr (UsesExtent<BoxTest>) hit = BoxTest::intersect(r, offsets, b.lane(lane), tmax, h);
+    else hit = BoxTest::intersect(r, b.lane(lane), tmax, h);
     entry[lane] = hit ? h.t_entry : std::numeric_limits<float>::infinity();
     mask |= static_cast<unsigned>(hit) << lane;
   }
@@ -120,12 +116,6 @@ struct RayLanes {
   simd::FloatLanes<W> org[3], inv_dir[3], far_inv_dir[3], fused_near[3], fused_far[3];
   int near_offset[3];  // from b.lower[a] to axis a's entry planes: 0 (lower) or 3W (upper)
   float tnear;
-
-  template <typename BoxTest = Slab>
-    requires(!UsesExtent<BoxTest>)
-  RAYBENCH_INLINE static RayLanes from(const Slab::Precomputed& r) {
-    return from<BoxTest>(r, BBox{});
-  }
 
   template <typename BoxTest = Slab>
   RAYBENCH_INLINE static RayLanes from(const Slab::Precomputed& r, [[maybe_unused]] const BBox& extent) {
