@@ -6,11 +6,7 @@ namespace raybench {
 
 BBox Scene::bounds() const {
   BBox b;
-  for (const Triangle& t : triangles) {
-    b.extend(t.v0);
-    b.extend(t.v1);
-    b.extend(t.v2);
-  }
+  for (const Triangle& t : triangles) b.extend(triangle_bounds(t));
   return b;
 }
 

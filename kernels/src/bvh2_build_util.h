@@ -1,6 +1,7 @@
-// What the BVH2 builders share (private to kernels/src): a triangle's box,
-// the SAH's leaf cost, a total order on float keys for sorting, and the
-// binned object split (binned SAH and SBVH builders).
+// What the BVH2 builders share (private to kernels/src): the SAH's leaf
+// cost, a total order on float keys for sorting, and the binned object split
+// (binned SAH and SBVH builders). A triangle's box is triangle_bounds
+// (prim/triangle.h).
 #pragma once
 
 #include <algorithm>
@@ -20,14 +21,6 @@
 #include "raybench/bvh/bvh2.h"
 
 namespace raybench::bvh2_build {
-
-inline BBox triangle_bounds(const Triangle& t) {
-  BBox b;
-  b.extend(t.v0);
-  b.extend(t.v1);
-  b.extend(t.v2);
-  return b;
-}
 
 // Leaf tests for n triangles tested `granularity` at a time, in units of one
 // triangle test (Bvh2BuildOptions::leaf_granularity).

@@ -192,7 +192,7 @@ Bvh2 build_bvh2_binned_sah(std::span<const Triangle> triangles, const Bvh2BuildO
       tbb::blocked_range<std::size_t>(0, triangles.size(), kGrain), RangeBounds{},
       [&](const tbb::blocked_range<std::size_t>& r, RangeBounds b) {
         for (std::size_t i = r.begin(); i != r.end(); ++i)
-          b.extend(*std::construct_at(&refs[i], PrimRef{bvh2_build::triangle_bounds(triangles[i]), static_cast<std::uint32_t>(i)}));
+          b.extend(*std::construct_at(&refs[i], PrimRef{triangle_bounds(triangles[i]), static_cast<std::uint32_t>(i)}));
         return b;
       },
       [](RangeBounds a, const RangeBounds& b) {

@@ -161,7 +161,7 @@ Bvh2 build_bvh2_lbvh(std::span<const Triangle> triangles, const Bvh2BuildOptions
   }
   std::vector<BBox> bounds(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) bounds[i] = bvh2_build::triangle_bounds(triangles[i]);
+    for (std::size_t i = r.begin(); i != r.end(); ++i) bounds[i] = triangle_bounds(triangles[i]);
   });
   const BBox centroid_bounds = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, n), BBox{},

@@ -444,7 +444,7 @@ Bvh2 build_bvh2_sbvh(std::span<const Triangle> triangles, const Bvh2BuildOptions
   std::vector<Ref> refs(std::max(capacity, n));
   BBox root;
   for (std::size_t i = 0; i < n; ++i) {
-    refs[i] = {bvh2_build::triangle_bounds(triangles[i]), static_cast<std::uint32_t>(i)};
+    refs[i] = {triangle_bounds(triangles[i]), static_cast<std::uint32_t>(i)};
     root.extend(refs[i].bounds);
   }
   std::vector<Bvh2Node> nodes(2 * refs.size());

@@ -41,7 +41,7 @@ class SweepBuilder {
       : nodes_(nodes), options_(options) {
     const std::size_t n = triangles.size();
     bounds_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) bounds_[i] = bvh2_build::triangle_bounds(triangles[i]);
+    for (std::size_t i = 0; i < n; ++i) bounds_[i] = triangle_bounds(triangles[i]);
     for (int axis = 0; axis < 3; ++axis) {
       std::vector<std::uint64_t> keyed(n);  // centroid key in the high half, index in the low half
       for (std::size_t i = 0; i < n; ++i)

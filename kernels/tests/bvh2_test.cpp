@@ -33,14 +33,6 @@ using testing::random_soup;
 using testing::rays_at;
 using testing::sphere_cluster;
 
-BBox bounds_of(const Triangle& t) {
-  BBox b;
-  b.extend(t.v0);
-  b.extend(t.v1);
-  b.extend(t.v2);
-  return b;
-}
-
 // Levels below the root of the deepest leaf.
 int depth_of(const Bvh2& bvh) {
   int deepest = 0;
@@ -97,11 +89,11 @@ void expect_valid(const Bvh2& bvh, const std::vector<Triangle>& tris, bool split
         leaves_of[id].push_back(n.bounds);
         if (splits) {
           BBox meet = n.bounds;
-          meet.lower = max(meet.lower, bounds_of(tris[id]).lower);
-          meet.upper = min(meet.upper, bounds_of(tris[id]).upper);
+          meet.lower = max(meet.lower, triangle_bounds(tris[id]).lower);
+          meet.upper = min(meet.upper, triangle_bounds(tris[id]).upper);
           EXPECT_FALSE(meet.empty()) << "a leaf holds triangle " << id << " but none of it";
         } else {
-          EXPECT_TRUE(n.bounds.contains(bounds_of(tris[id]))) << "leaf does not contain triangle " << id;
+          EXPECT_TRUE(n.bounds.contains(triangle_bounds(tris[id]))) << "leaf does not contain triangle " << id;
         }
       }
     } else {

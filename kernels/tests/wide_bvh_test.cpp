@@ -75,10 +75,7 @@ void check(const WideBvh<W>& bvh, const std::vector<Triangle>& tris, std::uint32
         const std::int32_t id = bvh.pack_prims[W * pack + i];
         if (id < 0) continue;
         leaves_of[static_cast<std::size_t>(id)].push_back(box);
-        BBox t;
-        t.extend(tris[id].v0);
-        t.extend(tris[id].v1);
-        t.extend(tris[id].v2);
+        BBox t = triangle_bounds(tris[id]);
         if (splits) {
           t.lower = max(t.lower, box.lower);
           t.upper = min(t.upper, box.upper);
@@ -105,11 +102,7 @@ TEST_P(WideBvhBuild, EveryTriangleInALeafUnderBoundsThatContainItOrTogetherCover
     // margins are computed over (a plane outside it could be missed).
     check(bvh, tris, 0, bvh.bounds, splits, leaves_of);
     BBox soup;
-    for (const Triangle& t : tris) {
-      soup.extend(t.v0);
-      soup.extend(t.v1);
-      soup.extend(t.v2);
-    }
+    for (const Triangle& t : tris) soup.extend(triangle_bounds(t));
     EXPECT_TRUE(bvh.bounds.contains(soup));
     for (std::size_t i = 0; i < tris.size(); ++i) {
       if (!splits) {

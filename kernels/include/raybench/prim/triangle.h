@@ -3,6 +3,7 @@
 
 #include <string_view>
 
+#include "raybench/math/bbox.h"
 #include "raybench/math/vec.h"
 
 namespace raybench {
@@ -10,6 +11,15 @@ namespace raybench {
 struct Triangle {
   Vec3f v0, v1, v2;
 };
+
+// The triangle's axis-aligned box.
+inline BBox triangle_bounds(const Triangle& t) {
+  BBox b;
+  b.extend(t.v0);
+  b.extend(t.v1);
+  b.extend(t.v2);
+  return b;
+}
 
 // What a ray-triangle test reports: distance along the ray and the
 // barycentric coordinates of the hit, p = (1-u-v) v0 + u v1 + v v2.
