@@ -61,12 +61,16 @@ inline int intersect8_watertight_scalar(const WatertightTriangle::RayData& ray, 
 #if defined(__AVX2__)
 RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData& r, float tmax, const TriangleVertices8& t,
                                       TriangleHit& out) {
-  // Axis kx of vertex k lies at px + 24 * k: one base per axis and constant
-  // offsets. Indexed as t.v[k][r.kx], the compiler kept nine offsets, spilled
-  // them, and reloaded each before its vertex load; with the bases, measured
-  // 4-10 % more shadow rays per second through bvh8:watertight:robust (bunny,
-  // Sibenik, Lucy, Sponza-Dabrovic, engine; one thread), primary and diffuse
-  // rays within noise.
+  // Axis kx of vertex k lies at px + kVertex * k: one base per axis and
+  // constant offsets. Indexed as t.v[k][r.kx], the compiler kept nine
+  // offsets, spilled them, and reloaded each before its vertex load; with the
+  // bases, measured 4-10 % more shadow rays per second through
+  // bvh8:watertight:robust (bunny, Sibenik, Lucy, Sponza-Dabrovic, engine;
+  // one thread), primary and diffuse rays within noise. The gain is fragile:
+  // the same bases taken from reinterpret_cast<const float*>(&t) compiled
+  // differently and measured no faster than indexing.
+  constexpr int kVertex = 3 * 8;  // floats from one vertex's axis to the next vertex's
+  static_assert(sizeof(TriangleVertices8::v[0]) == kVertex * sizeof(float));
   const float* px = t.v[0][r.kx];
   const float* py = t.v[0][r.ky];
   const float* pz = t.v[0][r.kz];
@@ -75,9 +79,9 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
   // Vertex k relative to the origin, sheared: (x, y) in the ray's frame and its kz component.
   __m256 x[3], y[3], z[3];
   for (int k = 0; k < 3; ++k) {
-    z[k] = _mm256_sub_ps(_mm256_load_ps(pz + 24 * k), oz);
-    x[k] = _mm256_fnmadd_ps(sx, z[k], _mm256_sub_ps(_mm256_load_ps(px + 24 * k), ox));
-    y[k] = _mm256_fnmadd_ps(sy, z[k], _mm256_sub_ps(_mm256_load_ps(py + 24 * k), oy));
+    z[k] = _mm256_sub_ps(_mm256_load_ps(pz + kVertex * k), oz);
+    x[k] = _mm256_fnmadd_ps(sx, z[k], _mm256_sub_ps(_mm256_load_ps(px + kVertex * k), ox));
+    y[k] = _mm256_fnmadd_ps(sy, z[k], _mm256_sub_ps(_mm256_load_ps(py + kVertex * k), oy));
   }
   const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
   const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
