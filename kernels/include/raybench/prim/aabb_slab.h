@@ -95,11 +95,16 @@ struct Slab {
     return h.t_entry <= h.t_exit && h.t_entry < std::numeric_limits<float>::infinity();
   }
 
-  RAYBENCH_INLINE static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
-    const BoxHit h = clip(ray, box, tmax);
+  // Every box test's answer from its clipped interval: a hit, written to
+  // `out`, when the interval overlaps; `out` untouched otherwise.
+  RAYBENCH_INLINE static bool report(const BoxHit& h, BoxHit& out) {
     if (!overlaps(h)) return false;
     out = h;
     return true;
+  }
+
+  RAYBENCH_INLINE static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
+    return report(clip(ray, box, tmax), out);
   }
 };
 

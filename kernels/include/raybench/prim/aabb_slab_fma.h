@@ -65,10 +65,7 @@ struct SlabFma {
   }
 
   RAYBENCH_INLINE static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
-    const BoxHit h = clip(ray, box, tmax);
-    if (!Slab::overlaps(h)) return false;
-    out = h;
-    return true;
+    return Slab::report(clip(ray, box, tmax), out);
   }
 };
 

@@ -115,10 +115,7 @@ struct SlabFmaRobust {
   // With offsets set over an extent that contains the box, for a ray it serves.
   RAYBENCH_INLINE static bool intersect(const Precomputed& ray, const Offsets& o, const BBox& box, float tmax,
                                         BoxHit& out) {
-    const BoxHit h = clip(ray, o, box, tmax);
-    if (!Slab::overlaps(h)) return false;
-    out = h;
-    return true;
+    return Slab::report(clip(ray, o, box, tmax), out);
   }
 };
 

@@ -66,9 +66,7 @@ struct SlabRobust {
   static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
     BoxHit h = Slab::clip(ray, box, tmax);
     h.t_exit = padded(h.t_exit);
-    if (!Slab::overlaps(h)) return false;
-    out = h;
-    return true;
+    return Slab::report(h, out);
   }
 };
 

@@ -62,10 +62,7 @@ struct SlabRobustRay {
   RAYBENCH_INLINE static bool intersect(const Precomputed& ray, const BBox& box, float tmax, BoxHit& out) {
     if (!serves(ray)) return Fallback::intersect(ray, box, tmax, out);
     const Vec3f far{far_inv_dir(ray.inv_dir.x), far_inv_dir(ray.inv_dir.y), far_inv_dir(ray.inv_dir.z)};
-    const BoxHit h = Slab::clip(ray, far, box, SlabRobust::padded(tmax));
-    if (!Slab::overlaps(h)) return false;
-    out = h;
-    return true;
+    return Slab::report(Slab::clip(ray, far, box, SlabRobust::padded(tmax)), out);
   }
 };
 
