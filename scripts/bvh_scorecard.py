@@ -1,6 +1,6 @@
 """Issue 4's scorecard: how our BVHs stand against Embree's best, per scene, from one results CSV.
 
-    scripts/bvh-scorecard RESULTS.csv [--out SCORECARD.md]
+    scripts/bvh-scorecard RESULTS.csv [--out SCORECARD.md] [--plot PICTURE.png | --no-plot]
 
 For every scene and the primary, diffuse and shadow ray sets (one thread), it compares:
 - our best backend (every backend not named embree* or reference) with Embree's best (the faster
@@ -13,7 +13,11 @@ For every scene and the primary, diffuse and shadow ray sets (one thread), it co
 - hit/miss agreement with Embree (>= 99.99 %) and same triangle where both hit, exact ties
   counted as agreeing (>= 99.9 %) for our best backend.
 Ratios are within the run, so they travel between machines; the run's metadata names the
-machine. Prints Markdown (or writes --out). Bad input: one line on stderr, exit 2.
+machine. When the CSV has each median's min and max over the repetitions, every ratio gets its
+range too (ours at its slowest / Embree at its fastest, to the reverse), and a ratio below a
+target is said to be within that noise or beyond it; the verdict stays the median's.
+Prints Markdown (or writes --out). With --out, a picture of the ratios (PNG beside it, or
+--plot) is drawn and linked from the Markdown. Bad input: one line on stderr, exit 2.
 """
 import argparse
 import math
@@ -21,12 +25,14 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from report import InputError, read_meta, read_table  # noqa: E402
+from report import (DPI, InputError, draw_grouped_bars, figure_width, pyplot, read_meta, read_table,  # noqa: E402
+                    rotate_if_crowded, wrap_title)
 
 RAYSETS = ("primary", "diffuse", "shadow")
 REQUIRED = ["scene", "rayset", "backend", "threads", "rays", "mrays_s", "build_ms", "hit_rate", "agree_hit",
             "agree_prim", "prim_ties"]
-NUMERIC = ["threads", "rays", "mrays_s", "build_ms", "hit_rate", "agree_hit", "agree_prim", "prim_ties"]
+NUMERIC = ["threads", "rays", "mrays_s", "build_ms", "hit_rate", "agree_hit", "agree_prim", "prim_ties", "mrays_s_min",
+           "mrays_s_max"]
 
 
 def is_ours(backend):
@@ -44,6 +50,16 @@ def same_triangle(row):
         return None
     both = row["hit_rate"] * row["rays"]
     return min(1.0, row["agree_prim"] + (row["prim_ties"] or 0) / both) if both else None
+
+
+def ratio_range(ours, theirs):
+    """(lowest, highest) of ours / theirs over the repetitions: ours at its min against theirs at
+    its max, and the reverse; None without the min and max columns."""
+    lo, hi = ours.get("mrays_s_min"), ours.get("mrays_s_max")
+    their_lo, their_hi = theirs.get("mrays_s_min"), theirs.get("mrays_s_max")
+    if None in (lo, hi, their_lo, their_hi) or not their_lo or not their_hi:
+        return None
+    return lo / their_hi, hi / their_lo
 
 
 def scorecard(rows, threads=1):
@@ -68,8 +84,10 @@ def scorecard(rows, threads=1):
             "scene": scene, "rayset": rayset,
             "embree": embree_name, "embree_mrays": embree["mrays_s"],
             "best": best_name, "best_mrays": best["mrays_s"], "ratio": best["mrays_s"] / embree["mrays_s"],
+            "ratio_range": ratio_range(best, embree),
             "watertight": wt_name,
             "watertight_ratio": wt["mrays_s"] / default["mrays_s"] if wt and default else None,
+            "watertight_range": ratio_range(wt, default) if wt and default else None,
             "build_ratio": builder["build_ms"] / default["build_ms"] if builder and default and default["build_ms"] else None,
             "build_ms": builder["build_ms"] if builder else None,
             "agree_hit": best["agree_hit"], "same_triangle": same_triangle(best),
@@ -117,7 +135,59 @@ def render_threads(rows, lines):
     return out
 
 
-def render(lines, meta, source, rows=()):
+def shortfall(lines, key, range_key):
+    """How many rows miss 1.0, and of those how many reach it within their repetitions' range:
+    "; 3 of 36 rows below 1.0, 2 of them within their min–max", or "" when none miss."""
+    measured = [x for x in lines if x[key] is not None]
+    below = [x for x in measured if x[key] < 1.0]
+    if not below:
+        return ""
+    text = f"; {len(below)} of {len(measured)} rows below 1.0"
+    if all(x[range_key] for x in below):
+        within = sum(1 for x in below if x[range_key][1] >= 1.0)
+        text += f", {within} of them within their min–max"
+    return text
+
+
+def plot_scorecard(path, lines, title):
+    """Two panels of bars grouped by scene, one bar per ray set: our best / Embree's best, and our
+    best watertight / Embree's default mode; whiskers min–max, the target 1.0 dashed."""
+    plt = pyplot()
+    scenes = list(dict.fromkeys(x["scene"] for x in lines))
+    by = {(x["scene"], x["rayset"]): x for x in lines}
+    colors = dict(zip(RAYSETS, ("tab:blue", "tab:orange", "tab:green")))
+    panels = [("ratio", "ratio_range", "our best / Embree's best"),
+              ("watertight_ratio", "watertight_range", "our watertight / Embree's default")]
+    panels = [p for p in panels if any(x[p[0]] is not None for x in lines)]
+    groups = scenes + ["geo. mean"]
+    fig, axes = plt.subplots(len(panels), 1, figsize=(figure_width(groups, len(RAYSETS)), 3.6 * len(panels)),
+                             layout="constrained", squeeze=False)
+    for ax, (key, range_key, label) in zip(axes[:, 0], panels):
+        means = {rs: geomean([x[key] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
+
+        def value_of(scene, rayset):
+            if scene == "geo. mean":
+                return None if means[rayset] is None else (means[rayset], None, None)
+            x = by.get((scene, rayset))
+            if x is None or x[key] is None:
+                return None
+            span = x[range_key]
+            return (x[key], span[0], span[1]) if span else (x[key], None, None)
+        draw_grouped_bars(ax, groups, RAYSETS, colors, value_of)
+        ax.axhline(1.0, color="black", linewidth=1.2, linestyle="--", zorder=4, label="target (= 1.0)")
+        ax.axvline(len(scenes) - 0.5, color="grey", linewidth=0.8, zorder=1)
+        values = [v for x in lines for v in (x[key], *(x[range_key] or ())) if v is not None]
+        ax.set_ylim(0, max(values + [1.0]) * 1.1)
+        ax.set_ylabel(label + " (×)")
+        ax.set_xticklabels(groups)
+        rotate_if_crowded(ax, fig, groups)
+        ax.legend(title="ray set (whisker: min–max)", loc="upper left", bbox_to_anchor=(1.0, 1.0), frameon=False)
+    axes[0, 0].set_title(wrap_title(title, fig))
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+
+
+def render(lines, meta, source, rows=(), plot=None):
     out = [f"# BVH scorecard: ours against Embree (issue 4)", "",
            f"From `{os.path.basename(source)}`, one thread, ratios within the run."]
     m = meta.get("machine", {}) if isinstance(meta.get("machine"), dict) else {}
@@ -130,11 +200,18 @@ def render(lines, meta, source, rows=()):
             "| build / embree | agree hit | same tri |", "|---|---|---|---:|---|---:|---:|---:|---:|---:|---:|"]
     def fmt(v, f, unit=""):
         return "-" if v is None else format(v, f) + unit
+
+    def with_range(v, span):
+        return fmt(v, ".2f") + ("" if v is None or span is None else f" ({span[0]:.2f}–{span[1]:.2f})")
     for x in lines:
         out.append(f"| {x['scene']} | {x['rayset']} | {x['embree']} | {x['embree_mrays']:.2f} | {x['best']} | "
-                   f"{x['best_mrays']:.2f} | {x['ratio']:.2f} | {fmt(x['watertight_ratio'], '.2f')} | "
+                   f"{x['best_mrays']:.2f} | {with_range(x['ratio'], x['ratio_range'])} | "
+                   f"{with_range(x['watertight_ratio'], x['watertight_range'])} | "
                    f"{fmt(x['build_ratio'], '.2f')} | {fmt(None if x['agree_hit'] is None else 100 * x['agree_hit'], '.3f', ' %')} | "
                    f"{fmt(None if x['same_triangle'] is None else 100 * x['same_triangle'], '.2f', ' %')} |")
+    if any(x["ratio_range"] for x in lines):
+        out += ["", "A ratio's range in brackets: ours at its slowest over the repetitions against Embree at its fastest, "
+                "and the reverse."]
     ratios = [x["ratio"] for x in lines]
     per_rayset = {rs: geomean([x["ratio"] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
     overall = geomean(ratios)
@@ -144,11 +221,12 @@ def render(lines, meta, source, rows=()):
             ", ".join(f"{rs} {v:.2f}" for rs, v in per_rayset.items() if v) + (f"; all {overall:.2f}." if overall else "."),
             "", "| target | measured | |", "|---|---|---|"]
     if ratios:
-        out.append(f"| our best ≥ 1.0 × Embree's best on every scene and ray set | min {min(ratios):.2f} | "
-                   f"{verdict(min(ratios) >= 1.0)} |")
+        out.append(f"| our best ≥ 1.0 × Embree's best on every scene and ray set | min {min(ratios):.2f}"
+                   f"{shortfall(lines, 'ratio', 'ratio_range')} | {verdict(min(ratios) >= 1.0)} |")
         out.append(f"| geometric mean ≥ 1.10 | {overall:.2f} | {verdict(overall >= 1.10)} |")
     if wts:
-        out.append(f"| watertight ≥ 1.0 × Embree's default mode | min {min(wts):.2f} | {verdict(min(wts) >= 1.0)} |")
+        out.append(f"| watertight ≥ 1.0 × Embree's default mode | min {min(wts):.2f}"
+                   f"{shortfall(lines, 'watertight_ratio', 'watertight_range')} | {verdict(min(wts) >= 1.0)} |")
     if builds:
         out.append(f"| default build ≤ 1.0 × Embree medium | max {max(builds.values()):.2f} | "
                    f"{verdict(max(builds.values()) <= 1.0)} |")
@@ -158,6 +236,8 @@ def render(lines, meta, source, rows=()):
         out.append(f"| hit/miss agreement ≥ 99.99 % | min {100 * min(agree):.3f} % | {verdict(min(agree) >= 0.9999)} |")
     if same:
         out.append(f"| same triangle ≥ 99.9 % (ties agree) | min {100 * min(same):.2f} % | {verdict(min(same) >= 0.999)} |")
+    if plot:
+        out += ["", f"![Our best and our best watertight backend against Embree, per scene and ray set]({plot})"]
     out += render_threads(rows, lines)
     return "\n".join(out) + "\n"
 
@@ -166,15 +246,26 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("results", help="results CSV of a run with embree (and embree:high) beside our backends")
     parser.add_argument("--out", help="write the Markdown here instead of stdout")
+    parser.add_argument("--plot", help="the picture of the ratios (PNG; default: beside --out, same name; none without --out)")
+    parser.add_argument("--no-plot", action="store_true", help="draw no picture")
     args = parser.parse_args(argv)
+    plot = None if args.no_plot else args.plot or (os.path.splitext(args.out)[0] + ".png" if args.out else None)
     try:
         rows = read_table(args.results, REQUIRED, NUMERIC)
         lines = scorecard(rows)
         if not lines:
             raise InputError(args.results, "no single-thread primary, diffuse or shadow rows with both Embree and one of our backends")
-        text = render(lines, read_meta(args.results), args.results, rows)
+        link = None
+        if plot:
+            plot_scorecard(plot, lines, "Issue 4: our BVHs against Embree, one thread, same rays, same run")
+            # Linked from the Markdown relative to where it is written.
+            link = os.path.relpath(plot, os.path.dirname(os.path.abspath(args.out))) if args.out else plot
+        text = render(lines, read_meta(args.results), args.results, rows, link)
     except InputError as e:
         print(f"bvh-scorecard: error: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:
+        print(f"bvh-scorecard: error: {e.filename or plot}: {e.strerror or e}", file=sys.stderr)
         return 2
     if args.out:
         with open(args.out, "w") as f:

@@ -16,16 +16,22 @@ def row(scene, rayset, backend, mrays, build=10.0, threads=1, agree_prim="1", ti
             "build_ms": build, "hit_rate": 0.5, "agree_hit": 1.0, "agree_prim": agree_prim, "prim_ties": ties}
 
 
+def spread(r, lo, hi):
+    """The row with its median's min and max over the repetitions."""
+    return {**r, "mrays_s_min": lo, "mrays_s_max": hi}
+
+
 class Scorecard(unittest.TestCase):
-    def run_on(self, rows):
+    def run_on(self, rows, *args, directory=None):
         with tempfile.TemporaryDirectory() as d:
-            path = os.path.join(d, "r.csv")
+            path = os.path.join(directory or d, "r.csv")
+            columns = COLUMNS + [c for c in ("mrays_s_min", "mrays_s_max") if any(c in r for r in rows)]
             with open(path, "w", newline="") as f:
-                w = csv.DictWriter(f, fieldnames=COLUMNS)
+                w = csv.DictWriter(f, fieldnames=columns)
                 w.writeheader()
                 w.writerows(rows)
-            return subprocess.run([sys.executable, os.path.join(HERE, "bvh_scorecard.py"), path], capture_output=True,
-                                  text=True)
+            return subprocess.run([sys.executable, os.path.join(HERE, "bvh_scorecard.py"), path, *args],
+                                  capture_output=True, text=True)
 
     def test_compares_our_best_with_embrees_best_and_says_which_targets_are_met(self):
         rows = []
@@ -60,9 +66,53 @@ class Scorecard(unittest.TestCase):
     def test_a_slower_scene_misses_the_per_scene_target(self):
         rows = [row("a", "primary", "embree", 10.0), row("a", "primary", "bvh2", 9.0, agree_prim="0.99", ties="5")]
         out = self.run_on(rows).stdout
-        self.assertIn("| our best ≥ 1.0 × Embree's best on every scene and ray set | min 0.90 | **missed** |", out)
+        self.assertIn("| our best ≥ 1.0 × Embree's best on every scene and ray set | min 0.90; 1 of 1 rows below 1.0 | "
+                      "**missed** |", out)
         # 0.99 same triangle plus 5 ties among 500 rays both hit: 100 %.
         self.assertIn("| same triangle ≥ 99.9 % (ties agree) | min 100.00 % | **met** |", out)
+
+    def test_each_ratio_gets_its_range_over_the_repetitions_and_a_miss_says_whether_noise_covers_it(self):
+        rows = [spread(row("a", "diffuse", "embree", 10.0), 9.0, 10.5),
+                spread(row("a", "diffuse", "bvh8", 9.5), 9.0, 10.8),  # below, but reaches 10.8 / 9 = 1.20
+                spread(row("b", "diffuse", "embree", 10.0), 9.9, 10.1),
+                spread(row("b", "diffuse", "bvh8", 9.0), 8.9, 9.1),  # below even at its fastest: 9.1 / 9.9
+                spread(row("c", "diffuse", "embree", 10.0), 9.9, 10.1),
+                spread(row("c", "diffuse", "bvh8", 12.0), 11.0, 12.5)]
+        out = self.run_on(rows, "--no-plot").stdout
+        # 9.0 / 10.5 = 0.86 at worst, 10.8 / 9.0 = 1.20 at best.
+        self.assertIn("| a | diffuse | embree | 10.00 | bvh8 | 9.50 | 0.95 (0.86–1.20) |", out)
+        self.assertIn("| b | diffuse | embree | 10.00 | bvh8 | 9.00 | 0.90 (0.88–0.92) |", out)
+        # The verdict is the median's; the shortfall says how much of it noise can explain.
+        self.assertIn("| our best ≥ 1.0 × Embree's best on every scene and ray set | min 0.90; 2 of 3 rows below 1.0, "
+                      "1 of them within their min–max | **missed** |", out)
+        self.assertIn("A ratio's range in brackets", out)
+
+    def test_with_out_a_picture_is_drawn_beside_the_markdown_and_linked_from_it(self):
+        rows = []
+        for rayset in ("primary", "diffuse", "shadow"):
+            rows += [spread(row("a", rayset, "embree", 10.0), 9.0, 11.0), spread(row("a", rayset, "bvh8", 12.0), 11.0, 13.0),
+                     spread(row("a", rayset, "bvh8:watertight", 9.0), 8.0, 9.5)]
+        with tempfile.TemporaryDirectory() as d:
+            md = os.path.join(d, "card.md")
+            result = self.run_on(rows, "--out", md, directory=d)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            with open(os.path.join(d, "card.png"), "rb") as f:
+                self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+            with open(md) as f:
+                self.assertIn("](card.png)", f.read())
+            # --no-plot: Markdown only, no link to a picture that is not there.
+            os.remove(os.path.join(d, "card.png"))
+            self.assertEqual(self.run_on(rows, "--out", md, "--no-plot", directory=d).returncode, 0)
+            self.assertFalse(os.path.exists(os.path.join(d, "card.png")))
+            with open(md) as f:
+                self.assertNotIn(".png", f.read())
+
+    def test_a_picture_that_cannot_be_written_is_one_line_and_exit_2(self):
+        rows = [row("a", "primary", "embree", 10.0), row("a", "primary", "bvh8", 12.0)]
+        result = self.run_on(rows, "--plot", "/nonexistent-dir/card.png")
+        self.assertEqual(result.returncode, 2)
+        self.assertEqual(len(result.stderr.strip().splitlines()), 1, result.stderr)
+        self.assertIn("bvh-scorecard: error:", result.stderr)
 
     def test_bad_input_is_one_line_and_exit_2(self):
         result = self.run_on([row("a", "uniform", "embree", 1.0)])
