@@ -366,6 +366,7 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   try {
+    raybench::record_source_state();  // the sources as built, before a long run
     return raybench::run(argc, argv);
   } catch (const raybench::InputError& e) {
     std::cerr << "raybench: error: " << e.what() << std::endl;

@@ -43,13 +43,6 @@ std::string run_command(const std::string& command) {
   return out;
 }
 
-std::string git_commit() {
-  const std::string dir = RAYBENCH_SOURCE_DIR;
-  std::string commit = run_command("git -C '" + dir + "' rev-parse HEAD 2>/dev/null");
-  if (commit.empty()) return "unknown";
-  if (!run_command("git -C '" + dir + "' status --porcelain --untracked-files=no 2>/dev/null").empty()) commit += "-dirty";
-  return commit;
-}
 
 std::string toml_string(const std::string& s) {
   std::string out = "\"";
@@ -62,6 +55,20 @@ std::string toml_string(const std::string& s) {
 }
 
 }  // namespace
+
+std::string source_state(const std::string& dir) {
+  const std::string git = "git -C '" + dir + "' ";
+  std::string commit = run_command(git + "rev-parse HEAD 2>/dev/null");
+  if (commit.empty()) return "unknown";
+  if (!run_command(git + "status --porcelain --untracked-files=no -- . ':(exclude,top)results' 2>/dev/null").empty())
+    commit += "-dirty";
+  return commit;
+}
+
+const std::string& record_source_state() {
+  static const std::string state = source_state(RAYBENCH_SOURCE_DIR);
+  return state;
+}
 
 Metadata collect_metadata(const Metadata& extra) {
   utsname u{};
@@ -80,7 +87,7 @@ Metadata collect_metadata(const Metadata& extra) {
       {"embree", embree_version()},
       {"assimp", fmt::format("{}.{}.{}", aiGetVersionMajor(), aiGetVersionMinor(), aiGetVersionPatch())},
       {"tbb", TBB_VERSION_STRING},
-      {"git_commit", git_commit()},
+      {"git_commit", record_source_state()},
       {"raybench_version", RAYBENCH_VERSION},
   };
   m.insert(m.end(), extra.begin(), extra.end());

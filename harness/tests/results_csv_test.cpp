@@ -3,7 +3,10 @@
 #include "results_csv.h"
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "error.h"
 #include "metadata.h"
@@ -114,6 +117,53 @@ TEST(Metadata, RecordsWhatAResultDependsOn) {
     EXPECT_FALSE(keys[k].empty()) << k;
   EXPECT_EQ(keys["embree"].rfind("3.", 0), 0u);
   EXPECT_EQ(metadata_path_for("results/latest.csv"), "results/latest.meta.toml");
+}
+
+// A git work tree in a temporary folder: one commit of a source file and a
+// results CSV.
+struct GitTree {
+  TempDir dir;
+  GitTree() {
+    std::filesystem::create_directories(dir.file("results"));
+    dir.write("kernel.cpp", "int x;\n");
+    dir.write("results/run.csv", "a\n1\n");
+    EXPECT_EQ(git("init -q"), 0);
+    EXPECT_EQ(git("add -A"), 0);
+    EXPECT_EQ(git("-c user.name=t -c user.email=t@example.org commit -qm first"), 0);
+  }
+  int git(const std::string& args) const {
+    return std::system(("git -C '" + dir.file("") + "' " + args + " >/dev/null 2>&1").c_str());
+  }
+};
+
+TEST(Metadata, SourceStateIsTheCommitAndDirtyWhenASourceFileDiffers) {
+  GitTree tree;
+  const std::string clean = source_state(tree.dir.file(""));
+  ASSERT_EQ(clean.size(), 40u) << clean;
+  tree.dir.write("notes.txt", "untracked\n");
+  EXPECT_EQ(source_state(tree.dir.file("")), clean);  // untracked files are not sources
+  tree.dir.write("kernel.cpp", "int y;\n");
+  EXPECT_EQ(source_state(tree.dir.file("")), clean + "-dirty");
+}
+
+TEST(Metadata, ARunsOwnOutputsUnderResultsDoNotMakeTheSourcesDirty) {
+  GitTree tree;
+  const std::string clean = source_state(tree.dir.file(""));
+  tree.dir.write("results/run.csv", "a\n2\n");  // a run rewriting the committed results
+  EXPECT_EQ(source_state(tree.dir.file("")), clean);
+}
+
+TEST(Metadata, OutsideAGitTreeTheSourceStateIsUnknown) {
+  TempDir dir;
+  EXPECT_EQ(source_state(dir.file("")), "unknown");
+}
+
+TEST(Metadata, TheGitCommitIsTheStateRecordedOnceWhenTheProcessStarted) {
+  const std::string& first = record_source_state();
+  EXPECT_EQ(&record_source_state(), &first);  // read once, kept
+  const Metadata m = collect_metadata({});
+  std::map<std::string, std::string> keys(m.begin(), m.end());
+  EXPECT_EQ(keys["git_commit"], first);
 }
 
 }  // namespace
