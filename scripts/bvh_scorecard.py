@@ -14,7 +14,7 @@ For every scene and the primary, diffuse and shadow ray sets (one thread), it co
   counted as agreeing (>= 99.9 %) for our best backend.
 Ratios are within the run, so they travel between machines; the run's metadata names the
 machine. When the CSV has each median's min and max over the repetitions, every ratio gets its
-range too (ours at its slowest / Embree at its fastest, to the reverse), and a ratio below a
+range too (ours at its slowest / Embree at its fastest, and the reverse), and a ratio below a
 target is said to be within that noise or beyond it; the verdict stays the median's.
 Prints Markdown (or writes --out). With --out, a picture of the ratios (PNG beside it, or
 --plot) is drawn and linked from the Markdown. Bad input: one line on stderr, exit 2.

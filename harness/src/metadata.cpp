@@ -43,7 +43,6 @@ std::string run_command(const std::string& command) {
   return out;
 }
 
-
 std::string toml_string(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
