@@ -114,6 +114,17 @@ class Scorecard(unittest.TestCase):
         self.assertEqual(len(result.stderr.strip().splitlines()), 1, result.stderr)
         self.assertIn("bvh-scorecard: error:", result.stderr)
 
+    def test_each_backend_alone_is_held_to_every_row_against_embrees_best(self):
+        rows = [row("a", "primary", "embree", 10.0), row("a", "primary", "bvh8", 12.0),
+                row("a", "primary", "bvh8:sbvh", 8.0),
+                row("b", "primary", "embree", 10.0), row("b", "primary", "bvh8", 9.0),
+                row("b", "primary", "bvh8:sbvh", 11.0)]
+        out = self.run_on(rows, "--no-plot").stdout
+        # The pick per row meets 1.0 on both; neither backend alone does.
+        self.assertIn("| our best ≥ 1.0 × Embree's best on every scene and ray set | min 1.10 | **met** |", out)
+        self.assertIn("| bvh8 | 1.04 | - | - | 1.04 | 1 of 2 |", out)  # sqrt(1.2 * 0.9)
+        self.assertIn("| bvh8:sbvh | 0.94 | - | - | 0.94 | 1 of 2 |", out)  # sqrt(0.8 * 1.1)
+
     def test_bad_input_is_one_line_and_exit_2(self):
         result = self.run_on([row("a", "uniform", "embree", 1.0)])
         self.assertEqual(result.returncode, 2)
