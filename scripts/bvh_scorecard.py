@@ -20,13 +20,12 @@ Prints Markdown (or writes --out). With --out, a picture of the ratios (PNG besi
 --plot) is drawn and linked from the Markdown. Bad input: one line on stderr, exit 2.
 """
 import argparse
-import math
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from report import (DPI, InputError, draw_grouped_bars, figure_width, pyplot, read_meta, read_table,  # noqa: E402
-                    rotate_if_crowded, wrap_title)
+from report import (DPI, InputError, draw_grouped_bars, figure_width, geometric_mean, pyplot, read_meta,  # noqa: E402
+                    read_table, rotate_if_crowded, wrap_title)
 
 RAYSETS = ("primary", "diffuse", "shadow")
 REQUIRED = ["scene", "rayset", "backend", "threads", "rays", "mrays_s", "build_ms", "hit_rate", "agree_hit",
@@ -37,11 +36,6 @@ NUMERIC = ["threads", "rays", "mrays_s", "build_ms", "hit_rate", "agree_hit", "a
 
 def is_ours(backend):
     return not backend.startswith("embree") and backend != "reference"
-
-
-def geomean(values):
-    values = [v for v in values if v and v > 0]
-    return math.exp(sum(math.log(v) for v in values) / len(values)) if values else None
 
 
 def same_triangle(row):
@@ -126,7 +120,7 @@ def render_threads(rows, lines):
                        f"{'-' if speedup is None else format(speedup, '.2f') + '×'} |")
         ratios = [x["ratio"] for x in many]
         builds = [x["build_ratio"] for x in many if x["build_ratio"] is not None]
-        out += ["", f"Geometric mean of our best / Embree's best with {t:g} threads: {geomean(ratios):.2f}."]
+        out += ["", f"Geometric mean of our best / Embree's best with {t:g} threads: {geometric_mean(ratios):.2f}."]
         if builds:
             out.append(f"Default build with {t:g} threads / Embree medium with {t:g} threads: max {max(builds):.2f} "
                        f"({verdict(max(builds) <= 1.0)} ≤ 1.0).")
@@ -160,10 +154,10 @@ def render_each(lines):
     out = ["", "Each of ours alone against Embree's best (geometric means; no pick per row):", "",
            "| backend | " + " | ".join(RAYSETS) + " | all | rows ≥ 1.0 |", "|---|" + "---:|" * (len(RAYSETS) + 2)]
     for b in names:
-        per = [geomean([x["each"][b] for x in lines if x["rayset"] == rs]) for rs in RAYSETS]
+        per = [geometric_mean([x["each"][b] for x in lines if x["rayset"] == rs]) for rs in RAYSETS]
         ratios = [x["each"][b] for x in lines]
         out.append(f"| {b} | " + " | ".join("-" if v is None else f"{v:.2f}" for v in per) +
-                   f" | {geomean(ratios):.2f} | {sum(r >= 1.0 for r in ratios)} of {len(ratios)} |")
+                   f" | {geometric_mean(ratios):.2f} | {sum(r >= 1.0 for r in ratios)} of {len(ratios)} |")
     return out
 
 
@@ -181,7 +175,7 @@ def plot_scorecard(path, lines, title):
     fig, axes = plt.subplots(len(panels), 1, figsize=(figure_width(groups, len(RAYSETS)), 3.6 * len(panels)),
                              layout="constrained", squeeze=False)
     for ax, (key, range_key, label) in zip(axes[:, 0], panels):
-        means = {rs: geomean([x[key] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
+        means = {rs: geometric_mean([x[key] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
 
         def value_of(scene, rayset):
             if scene == "geo. mean":
@@ -231,8 +225,8 @@ def render(lines, meta, source, rows=(), plot=None):
         out += ["", "A ratio's range in brackets: ours at its slowest over the repetitions against Embree at its fastest, "
                 "and the reverse."]
     ratios = [x["ratio"] for x in lines]
-    per_rayset = {rs: geomean([x["ratio"] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
-    overall = geomean(ratios)
+    per_rayset = {rs: geometric_mean([x["ratio"] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
+    overall = geometric_mean(ratios)
     wts = [x["watertight_ratio"] for x in lines if x["watertight_ratio"] is not None]
     builds = {x["scene"]: x["build_ratio"] for x in lines if x["build_ratio"] is not None}
     out += ["", "Geometric mean of our best / Embree's best: " +
