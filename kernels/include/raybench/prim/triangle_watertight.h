@@ -42,6 +42,10 @@ struct WatertightTriangle {
     float tnear;
     int kx, ky, kz;
     float sx, sy, sz;
+    // org[kx], org[ky], org[kz], set once per ray: indexed in the 8-wide
+    // leaf, org[r.kx] compiled to two compares and branches per axis on the
+    // origin GCC held in registers, about 20 instructions per leaf.
+    float ox, oy, oz;
   };
   RAYBENCH_INLINE static RayData precompute(const Ray& ray) {
     RayData r;
@@ -55,6 +59,7 @@ struct WatertightTriangle {
     r.sx = ray.dir[r.kx] / ray.dir[r.kz];
     r.sy = ray.dir[r.ky] / ray.dir[r.kz];
     r.sz = 1.0f / ray.dir[r.kz];
+    r.ox = ray.org[r.kx], r.oy = ray.org[r.ky], r.oz = ray.org[r.kz];
     return r;
   }
 

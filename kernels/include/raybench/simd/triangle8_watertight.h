@@ -75,7 +75,7 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
   const float* py = t.v[0][r.ky];
   const float* pz = t.v[0][r.kz];
   const __m256 sx = _mm256_set1_ps(r.sx), sy = _mm256_set1_ps(r.sy), sz = _mm256_set1_ps(r.sz);
-  const __m256 ox = _mm256_set1_ps(r.org[r.kx]), oy = _mm256_set1_ps(r.org[r.ky]), oz = _mm256_set1_ps(r.org[r.kz]);
+  const __m256 ox = _mm256_set1_ps(r.ox), oy = _mm256_set1_ps(r.oy), oz = _mm256_set1_ps(r.oz);
   // Vertex k relative to the origin, sheared: (x, y) in the ray's frame and its kz component.
   __m256 x[3], y[3], z[3];
   for (int k = 0; k < 3; ++k) {
