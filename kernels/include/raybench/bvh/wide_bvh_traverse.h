@@ -174,12 +174,17 @@ RAYBENCH_INLINE Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
   // A popped subtree farther than the current hit is skipped; a
   // conservative test compares with the padded bound (each pads tmax or
   // every exit by SlabRobust's 8u), so it never skips what it entered.
-  const auto reachable = [](float entry, float tmax) {
-    if constexpr (BoxTest::accuracy == AccuracyClass::kConservative)
-      return entry <= SlabRobust::padded(tmax);
-    else return entry <= tmax;
+  const auto reach_bound = [](float tmax) {
+    if constexpr (BoxTest::accuracy == AccuracyClass::kConservative) return SlabRobust::padded(tmax);
+    else return tmax;
   };
   float tmax = ray.tfar;
+  // Both bounds change with tmax only, at a hit: set there, not per node
+  // (the padding alone is five scalar operations).
+  float reach = reach_bound(tmax);
+#if defined(__AVX2__)
+  float exit_bound = box_exit_bound<BoxTest>(tmax);
+#endif
   wide_bvh_detail::Stack<W> stack;
   stack.top = 0;
   std::uint32_t ref = 0;  // the node or leaf visited next: the root first
@@ -190,13 +195,17 @@ RAYBENCH_INLINE Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
       const int lane = Leaf::intersect(leaf_ray, tmax, bvh, pack, th);
       if (lane >= 0) {
         tmax = th.t;
+        reach = reach_bound(tmax);
+#if defined(__AVX2__)
+        exit_bound = box_exit_bound<BoxTest>(tmax);
+#endif
         hit = {th.t, bvh.pack_prims[W * pack + static_cast<std::uint32_t>(lane)], th.u, th.v};
         if (AnyHit) return hit;
       }
     } else {
       const WideNode<W>& node = bvh.nodes[ref];
 #if defined(__AVX2__)
-      const BoxHits<W> box = slab_lanes<BoxTest>(ray_lanes, tmax, node.bounds);
+      const BoxHits<W> box = slab_lanes<BoxTest>(ray_lanes, exit_bound, node.bounds);
       const unsigned hit_lanes = box.hit.mask();
       // Descend straight into the child visited next, without a round trip
       // through the stack; its entry distance is within tmax (the box test
@@ -236,7 +245,7 @@ RAYBENCH_INLINE Hit traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
     do {
       if (stack.top == 0) return hit;
       --stack.top;
-    } while (!AnyHit && !reachable(stack.entry[stack.top], tmax));
+    } while (!AnyHit && !(stack.entry[stack.top] <= reach));
     ref = stack.ref[stack.top];
   }
 }

@@ -143,26 +143,35 @@ struct RayLanes {
   }
 };
 
+// What a node's exits are clamped to for a ray whose closest hit so far is
+// at tmax. Slab::overlaps asks entry <= exit and entry < +inf (an entry at
+// +inf is never reached). With the exit clamped to the largest float,
+// entry <= exit says both: one comparison per node instead of two and an
+// and. The clamp goes on tmax (std::min keeps a NaN tmax NaN, a miss), or,
+// for SlabRobust, on the padded exit, which may round up to +inf.
+// SlabRobustRay and SlabFmaRobust pad tmax (a NaN tmax stays NaN through
+// std::min, a miss); their far distances come padded from far_inv_dir or
+// fused_far. A traversal computes it when tmax changes, not per node: the
+// padding is five scalar operations.
+template <typename BoxTest = Slab>
+RAYBENCH_INLINE float box_exit_bound(float tmax) {
+  constexpr bool kPadsTmax = std::is_same_v<BoxTest, SlabRobustRay> || std::is_same_v<BoxTest, SlabFmaRobust>;
+  constexpr float kLargest = std::numeric_limits<float>::max();
+  if constexpr (kPadsTmax) return std::min(SlabRobust::padded(tmax), kLargest);
+  else if constexpr (std::is_same_v<BoxTest, SlabRobust>) return tmax;
+  else return std::min(tmax, kLargest);
+}
+
 // With BoxTest = SlabFma or SlabFmaRobust each distance is one fused
 // multiply-add; the caller has checked BoxTest::serves(r) (every 1/d
 // finite), as intersect_boxes_simd and traverse_wide do once per ray.
+// exit_bound is box_exit_bound<BoxTest>(tmax).
 template <typename BoxTest = Slab, int W>
-RAYBENCH_INLINE BoxHits<W> slab_lanes(const RayLanes<W>& r, float tmax, const BBoxWide<W>& b) {
+RAYBENCH_INLINE BoxHits<W> slab_lanes(const RayLanes<W>& r, float exit_bound, const BBoxWide<W>& b) {
   using F = simd::FloatLanes<W>;
   constexpr bool kRobust = std::is_same_v<BoxTest, SlabRobust>;
-  constexpr bool kPadsTmax = std::is_same_v<BoxTest, SlabRobustRay> || std::is_same_v<BoxTest, SlabFmaRobust>;
   constexpr bool kFused = std::is_same_v<BoxTest, SlabFma> || std::is_same_v<BoxTest, SlabFmaRobust>;
   constexpr float kLargest = std::numeric_limits<float>::max();
-  // Slab::overlaps asks entry <= exit and entry < +inf (an entry at +inf is
-  // never reached). With the exit clamped to the largest float, entry <=
-  // exit says both: one comparison per node instead of two and an and. The
-  // clamp goes on tmax (std::min keeps a NaN tmax NaN, a miss), or, for the
-  // robust test, on the padded exit, which may round up to +inf.
-  // SlabRobustRay and SlabFmaRobust pad tmax (a NaN tmax stays NaN through
-  // std::min, a miss); their far distances come padded from far_inv_dir or fused_far.
-  const float exit_bound = kPadsTmax ? std::min(SlabRobust::padded(tmax), kLargest)
-                           : kRobust  ? tmax
-                                      : std::min(tmax, kLargest);
   F t_entry = F::set1(r.tnear), t_exit = F::set1(exit_bound);
   // The box's 6W floats as one array: lower[a] at a * W, upper[a] at (3 + a) * W.
   static_assert(offsetof(BBoxWide<W>, upper) == 3 * W * sizeof(float) && sizeof(BBoxWide<W>) == 6 * W * sizeof(float));
@@ -193,7 +202,8 @@ template <typename BoxTest = Slab, int W>
 inline unsigned intersect_boxes_simd(const Slab::Precomputed& r, float tmax, const BBoxWide<W>& b, float entry[W]) {
   if constexpr (HasFallback<BoxTest>)
     if (!BoxTest::serves(r)) return intersect_boxes_simd<typename BoxTest::Fallback>(r, tmax, b, entry);
-  const BoxHits<W> h = slab_lanes<BoxTest>(RayLanes<W>::template from<BoxTest>(r, b.bounds()), tmax, b);
+  const BoxHits<W> h =
+      slab_lanes<BoxTest>(RayLanes<W>::template from<BoxTest>(r, b.bounds()), box_exit_bound<BoxTest>(tmax), b);
   alignas(32) float t[W];
   h.t_entry.storeu(t);
   const unsigned mask = h.hit.mask();
