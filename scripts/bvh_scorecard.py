@@ -15,7 +15,9 @@ For every scene and the primary, diffuse and shadow ray sets (one thread), it co
 Ratios are within the run, so they travel between machines; the run's metadata names the
 machine. When the CSV has each median's min and max over the repetitions, every ratio gets its
 range too (ours at its slowest / Embree at its fastest, and the reverse), and a ratio below a
-target is said to be within that noise or beyond it; the verdict stays the median's.
+target is said to be within that noise or beyond it; the verdict stays the median's. Build times
+likewise, from their min and max over the timed builds (a build ratio above 1.0, or a build no
+faster with more threads, is said to be within their range or beyond it).
 Prints Markdown (or writes --out). With --out, a picture of the ratios (PNG beside it, or
 --plot) is drawn and linked from the Markdown. Bad input: one line on stderr, exit 2.
 """
@@ -31,7 +33,7 @@ RAYSETS = ("primary", "diffuse", "shadow")
 REQUIRED = ["scene", "rayset", "backend", "threads", "rays", "mrays_s", "build_ms", "hit_rate", "agree_hit",
             "agree_prim", "prim_ties"]
 NUMERIC = ["threads", "rays", "mrays_s", "build_ms", "hit_rate", "agree_hit", "agree_prim", "prim_ties", "mrays_s_min",
-           "mrays_s_max"]
+           "mrays_s_max", "build_ms_min", "build_ms_max"]
 
 
 def is_ours(backend):
@@ -51,6 +53,16 @@ def ratio_range(ours, theirs):
     its max, and the reverse; None without the min and max columns."""
     lo, hi = ours.get("mrays_s_min"), ours.get("mrays_s_max")
     their_lo, their_hi = theirs.get("mrays_s_min"), theirs.get("mrays_s_max")
+    if None in (lo, hi, their_lo, their_hi) or not their_lo or not their_hi:
+        return None
+    return lo / their_hi, hi / their_lo
+
+
+def build_range(ours, theirs):
+    """(lowest, highest) of our build time / theirs over the timed builds: ours at its fastest
+    against theirs at its slowest, and the reverse; None without the min and max columns."""
+    lo, hi = ours.get("build_ms_min"), ours.get("build_ms_max")
+    their_lo, their_hi = theirs.get("build_ms_min"), theirs.get("build_ms_max")
     if None in (lo, hi, their_lo, their_hi) or not their_lo or not their_hi:
         return None
     return lo / their_hi, hi / their_lo
@@ -83,7 +95,8 @@ def scorecard(rows, threads=1):
             "watertight_ratio": wt["mrays_s"] / default["mrays_s"] if wt and default else None,
             "watertight_range": ratio_range(wt, default) if wt and default else None,
             "build_ratio": builder["build_ms"] / default["build_ms"] if builder and default and default["build_ms"] else None,
-            "build_ms": builder["build_ms"] if builder else None,
+            "build_range": build_range(builder, default) if builder and default else None,
+            **{k: builder.get(k) if builder else None for k in ("build_ms", "build_ms_min", "build_ms_max")},
             "agree_hit": best["agree_hit"], "same_triangle": same_triangle(best),
             "each": {b: r["mrays_s"] / embree["mrays_s"] for b, r in ours.items()},
         })
@@ -108,38 +121,45 @@ def render_threads(rows, lines):
                 "TBB threads trace the same chunks of rays for Embree and ours; Embree builds with the same thread count.",
                 "", f"| scene | ray set | our best | ratio, {t:g} threads | ratio, 1 thread | build / embree, {t:g} threads "
                 "| our build, 1 → {:g} threads |".format(t), "|---|---|---|---:|---:|---:|---:|"]
-        speedups = []
+        speedups = []  # one per scene (its ray sets share the build), with its range over the timed builds
         for x in many:
             base = one.get((x["scene"], x["rayset"]))
             speedup = base["build_ms"] / x["build_ms"] if base and base.get("build_ms") and x["build_ms"] else None
             if speedup and x["rayset"] == RAYSETS[0]:
-                speedups.append(speedup)
+                ends = (base["build_ms_min"], base["build_ms_max"], x["build_ms_min"], x["build_ms_max"])
+                span = None if None in ends or not all(ends) else (ends[0] / ends[3], ends[1] / ends[2])
+                speedups.append({"speedup": speedup, "speedup_range": span})
             out.append(f"| {x['scene']} | {x['rayset']} | {x['best']} | {x['ratio']:.2f} | "
                        f"{'-' if not base else format(base['ratio'], '.2f')} | "
                        f"{'-' if x['build_ratio'] is None else format(x['build_ratio'], '.2f')} | "
                        f"{'-' if speedup is None else format(speedup, '.2f') + '×'} |")
         ratios = [x["ratio"] for x in many]
-        builds = [x["build_ratio"] for x in many if x["build_ratio"] is not None]
+        build_lines = list({x["scene"]: x for x in many if x["build_ratio"] is not None}.values())
+        builds = [x["build_ratio"] for x in build_lines]
         out += ["", f"Geometric mean of our best / Embree's best with {t:g} threads: {geometric_mean(ratios):.2f}."]
         if builds:
             out.append(f"Default build with {t:g} threads / Embree medium with {t:g} threads: max {max(builds):.2f} "
-                       f"({verdict(max(builds) <= 1.0)} ≤ 1.0).")
+                       f"({verdict(max(builds) <= 1.0)} ≤ 1.0"
+                       f"{shortfall(build_lines, 'build_ratio', 'build_range', above=True, unit='scenes')}).")
         if speedups:
-            out.append(f"Our default build, 1 → {t:g} threads: {min(speedups):.2f}–{max(speedups):.2f}× faster "
-                       f"({verdict(min(speedups) > 1.0)}: faster on every scene).")
+            fastest = [x["speedup"] for x in speedups]
+            out.append(f"Our default build, 1 → {t:g} threads: {min(fastest):.2f}–{max(fastest):.2f}× faster "
+                       f"({verdict(min(fastest) > 1.0)}: faster on every scene"
+                       f"{shortfall(speedups, 'speedup', 'speedup_range', unit='scenes')}).")
     return out
 
 
-def shortfall(lines, key, range_key):
+def shortfall(lines, key, range_key, above=False, unit="rows"):
     """How many rows miss 1.0, and of those how many reach it within their repetitions' range:
-    "; 3 of 36 rows below 1.0, 2 of them within their min–max", or "" when none miss."""
+    "; 3 of 36 rows below 1.0, 2 of them within their min–max", or "" when none miss. With
+    `above`, the target is at most 1.0 (a build time ratio) and misses are above it."""
     measured = [x for x in lines if x[key] is not None]
-    below = [x for x in measured if x[key] < 1.0]
-    if not below:
+    missed = [x for x in measured if (x[key] > 1.0 if above else x[key] < 1.0)]
+    if not missed:
         return ""
-    text = f"; {len(below)} of {len(measured)} rows below 1.0"
-    if all(x[range_key] for x in below):
-        within = sum(1 for x in below if x[range_key][1] >= 1.0)
+    text = f"; {len(missed)} of {len(measured)} {unit} {'above' if above else 'below'} 1.0"
+    if all(x[range_key] for x in missed):
+        within = sum(1 for x in missed if (x[range_key][0] <= 1.0 if above else x[range_key][1] >= 1.0))
         text += f", {within} of them within their min–max"
     return text
 
@@ -219,16 +239,18 @@ def render(lines, meta, source, rows=(), plot=None):
         out.append(f"| {x['scene']} | {x['rayset']} | {x['embree']} | {x['embree_mrays']:.2f} | {x['best']} | "
                    f"{x['best_mrays']:.2f} | {with_range(x['ratio'], x['ratio_range'])} | "
                    f"{with_range(x['watertight_ratio'], x['watertight_range'])} | "
-                   f"{fmt(x['build_ratio'], '.2f')} | {fmt(None if x['agree_hit'] is None else 100 * x['agree_hit'], '.3f', ' %')} | "
+                   f"{with_range(x['build_ratio'], x['build_range'])} | {fmt(None if x['agree_hit'] is None else 100 * x['agree_hit'], '.3f', ' %')} | "
                    f"{fmt(None if x['same_triangle'] is None else 100 * x['same_triangle'], '.2f', ' %')} |")
     if any(x["ratio_range"] for x in lines):
         out += ["", "A ratio's range in brackets: ours at its slowest over the repetitions against Embree at its fastest, "
-                "and the reverse."]
+                "and the reverse; for build times, our fastest build against Embree's slowest, and the reverse."]
     ratios = [x["ratio"] for x in lines]
     per_rayset = {rs: geometric_mean([x["ratio"] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
     overall = geometric_mean(ratios)
     wts = [x["watertight_ratio"] for x in lines if x["watertight_ratio"] is not None]
-    builds = {x["scene"]: x["build_ratio"] for x in lines if x["build_ratio"] is not None}
+    # One build per scene: the rows of its ray sets share it.
+    build_lines = list({x["scene"]: x for x in lines if x["build_ratio"] is not None}.values())
+    builds = [x["build_ratio"] for x in build_lines]
     out += ["", "Geometric mean of our best / Embree's best: " +
             ", ".join(f"{rs} {v:.2f}" for rs, v in per_rayset.items() if v) + (f"; all {overall:.2f}." if overall else "."),
             "", "| target | measured | |", "|---|---|---|"]
@@ -240,8 +262,9 @@ def render(lines, meta, source, rows=(), plot=None):
         out.append(f"| watertight ≥ 1.0 × Embree's default mode | min {min(wts):.2f}"
                    f"{shortfall(lines, 'watertight_ratio', 'watertight_range')} | {verdict(min(wts) >= 1.0)} |")
     if builds:
-        out.append(f"| default build ≤ 1.0 × Embree medium | max {max(builds.values()):.2f} | "
-                   f"{verdict(max(builds.values()) <= 1.0)} |")
+        out.append(f"| default build ≤ 1.0 × Embree medium | max {max(builds):.2f}"
+                   f"{shortfall(build_lines, 'build_ratio', 'build_range', above=True, unit='scenes')} | "
+                   f"{verdict(max(builds) <= 1.0)} |")
     agree = [x["agree_hit"] for x in lines if x["agree_hit"] is not None]
     same = [x["same_triangle"] for x in lines if x["same_triangle"] is not None]
     if agree:
