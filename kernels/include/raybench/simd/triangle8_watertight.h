@@ -88,25 +88,30 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
   const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
   const __m256 zero = _mm256_setzero_ps();
   // Outside: the smallest determinant negative and the largest positive.
-  // min/max return one of their operands, so this says outside only where
-  // the scalar test does; where a NaN hides a sign from them, det is NaN
-  // and the lane misses in both.
+  // Strictly inside: all three of one sign, none zero. min/max return one
+  // of their operands, so these say what the scalar test says; where a NaN
+  // hides a sign from them, neither holds for it (det is NaN too).
   const __m256 smallest = _mm256_min_ps(_mm256_min_ps(u, v), w), largest = _mm256_max_ps(_mm256_max_ps(u, v), w);
-  const __m256 outside = _mm256_and_ps(_mm256_cmp_ps(smallest, zero, _CMP_LT_OQ), _mm256_cmp_ps(largest, zero, _CMP_GT_OQ));
-  // Lanes on an edge in float and not already outside: the scalar test
-  // decides them in double.
-  const __m256 on_edge = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_EQ_OQ), _mm256_cmp_ps(v, zero, _CMP_EQ_OQ)),
-                                      _mm256_cmp_ps(w, zero, _CMP_EQ_OQ));
-  const int exact = _mm256_movemask_ps(_mm256_andnot_ps(outside, on_edge));
+  const __m256 below = _mm256_cmp_ps(smallest, zero, _CMP_LT_OQ), above = _mm256_cmp_ps(largest, zero, _CMP_GT_OQ);
+  const __m256 outside = _mm256_and_ps(below, above);
+  const __m256 inside = _mm256_or_ps(_mm256_cmp_ps(smallest, zero, _CMP_GT_OQ), _mm256_cmp_ps(largest, zero, _CMP_LT_OQ));
   const __m256 det = _mm256_add_ps(_mm256_add_ps(u, v), w);
+  // Neither outside nor strictly inside, and not NaN: on an edge in float,
+  // for the scalar test to decide in double.
+  const int exact = _mm256_movemask_ps(_mm256_andnot_ps(_mm256_or_ps(outside, inside), _mm256_cmp_ps(det, det, _CMP_ORD_Q)));
   const __m256 t_scaled = _mm256_fmadd_ps(u, _mm256_mul_ps(sz, z[0]),
                                           _mm256_fmadd_ps(v, _mm256_mul_ps(sz, z[1]), _mm256_mul_ps(w, _mm256_mul_ps(sz, z[2]))));
   const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
   const __m256 tt = _mm256_mul_ps(t_scaled, inv_det);
-  __m256 ok = _mm256_andnot_ps(outside, _mm256_cmp_ps(det, zero, _CMP_NEQ_OQ));
-  ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(tt, _mm256_set1_ps(r.tnear), _CMP_GT_OQ),
-                                       _mm256_cmp_ps(tt, _mm256_set1_ps(tmax), _CMP_LE_OQ)));
-  int mask = _mm256_movemask_ps(ok) & ~exact;
+  // A lane strictly inside has det != 0 (three nonzero values of one sign
+  // do not sum to 0) and is never one of the exact lanes: no more tests.
+  // Measured against testing det != 0 and on-edge lanes (u, v or w == 0)
+  // separately, 2 operations more, interleaved, one thread: shadow rays
+  // through bvh8:watertight:robust 2-3 % faster (11 rows of 6 scenes, two
+  // batches), diffuse and primary within noise.
+  const __m256 ok = _mm256_and_ps(inside, _mm256_and_ps(_mm256_cmp_ps(tt, _mm256_set1_ps(r.tnear), _CMP_GT_OQ),
+                                                        _mm256_cmp_ps(tt, _mm256_set1_ps(tmax), _CMP_LE_OQ)));
+  int mask = _mm256_movemask_ps(ok);
   if (!mask && !exact) return -1;
   alignas(32) float ts[8], us[8], vs[8];
   _mm256_store_ps(ts, tt);
