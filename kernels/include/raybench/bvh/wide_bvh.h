@@ -80,7 +80,7 @@ struct WideBvh {
   HugePageVector<WideNode<W>> nodes;               // nodes[0] is the root
   HugePageVector<TrianglePack<W>> packs;           // WideLeaves::kMollerTrumbore: up to W triangles each
   HugePageVector<TriangleVertices8> vertex_packs;  // WideLeaves::kVertices (W = 8): the same packs as vertices
-  HugePageVector<std::int32_t> pack_prims;         // W per pack: input triangle index, -1 in unused lanes
+  HugePageVector<std::int32_t> pack_prims;         // W per pack: input triangle index, -1 in unused lanes (vertex packs carry a copy)
   std::size_t depth = 0;                        // levels below the root; bounds the traversal stack
   // The union of the root's child boxes, which contain every box below them:
   // the extent of every plane a ray is tested against (SlabFmaRobust's).

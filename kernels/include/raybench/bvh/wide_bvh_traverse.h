@@ -139,6 +139,11 @@ struct WideMollerTrumbore {
   RAYBENCH_INLINE static int intersect(const RayData& ray, float tmax, const WideBvh<W>& bvh, std::uint32_t pack, TriangleHit& out) {
     return intersect_pack(ray, tmax, bvh.packs[pack], out);
   }
+  // The input triangle of a pack's lane.
+  template <int W>
+  RAYBENCH_INLINE static std::int32_t prim(const WideBvh<W>& bvh, std::uint32_t pack, int lane) {
+    return bvh.pack_prims[W * pack + static_cast<std::uint32_t>(lane)];
+  }
 };
 
 struct Bvh8Watertight {
@@ -147,6 +152,10 @@ struct Bvh8Watertight {
   RAYBENCH_INLINE static RayData precompute(const Ray& ray) { return WatertightTriangle::precompute(ray); }
   RAYBENCH_INLINE static int intersect(const RayData& ray, float tmax, const Bvh8& bvh, std::uint32_t pack, TriangleHit& out) {
     return intersect8_watertight(ray, tmax, bvh.vertex_packs[pack], out);
+  }
+  // From the pack's own copy, in a line the test has just loaded.
+  RAYBENCH_INLINE static std::int32_t prim(const Bvh8& bvh, std::uint32_t pack, int lane) {
+    return bvh.vertex_packs[pack].prim[lane];
   }
 };
 
@@ -210,7 +219,7 @@ RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide(const WideBv
         // 4-5 % faster without (bvh8, bvh8:sbvh:reinsert,
         // bvh8:watertight:robust; every one of the 18 rows faster).
         if constexpr (AnyHit) return true;
-        else hit = {th.t, bvh.pack_prims[W * pack + static_cast<std::uint32_t>(lane)], th.u, th.v};
+        else hit = {th.t, Leaf::prim(bvh, pack, lane), th.u, th.v};
       }
     } else {
       const WideNode<W>& node = bvh.nodes[ref];
