@@ -64,8 +64,15 @@ class WideBvhBackend final : public Backend {
   double sah_cost() const override { return bvh_.sah_cost(); }
 
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
+    // Leaves that do not carry their triangles report pack slots, mapped
+    // to triangles here, after the batch (traverse_wide's PackSlots).
+    constexpr bool kSlots = !Leaf::kPrimsInPack;
     for (std::size_t i = 0; i < rays.size(); ++i)
-      hits[i] = is_traceable(rays[i]) ? intersect_wide<Leaf, BoxTest>(bvh_, with_nonnegative_tnear(rays[i])) : Hit{};
+      hits[i] = is_traceable(rays[i]) ? traverse_wide<false, Leaf, BoxTest, kSlots>(bvh_, with_nonnegative_tnear(rays[i]))
+                                      : Hit{};
+    if constexpr (kSlots)
+      for (Hit& h : hits)
+        if (h.hit()) h.prim = bvh_.pack_prims[static_cast<std::uint32_t>(h.prim)];
   }
 
   void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override {
