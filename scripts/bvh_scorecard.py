@@ -48,24 +48,20 @@ def same_triangle(row):
     return min(1.0, row["agree_prim"] + (row["prim_ties"] or 0) / both) if both else None
 
 
-def ratio_range(ours, theirs):
-    """(lowest, highest) of ours / theirs over the repetitions: ours at its min against theirs at
-    its max, and the reverse; None without the min and max columns."""
-    lo, hi = ours.get("mrays_s_min"), ours.get("mrays_s_max")
-    their_lo, their_hi = theirs.get("mrays_s_min"), theirs.get("mrays_s_max")
+def ratio_range(ours, theirs, column="mrays_s"):
+    """(lowest, highest) of ours / theirs in `column` over the repetitions (mrays_s, or build_ms
+    over the timed builds): ours at its min against theirs at its max, and the reverse; None
+    without the column's min and max."""
+    lo, hi = ours.get(column + "_min"), ours.get(column + "_max")
+    their_lo, their_hi = theirs.get(column + "_min"), theirs.get(column + "_max")
     if None in (lo, hi, their_lo, their_hi) or not their_lo or not their_hi:
         return None
     return lo / their_hi, hi / their_lo
 
 
-def build_range(ours, theirs):
-    """(lowest, highest) of our build time / theirs over the timed builds: ours at its fastest
-    against theirs at its slowest, and the reverse; None without the min and max columns."""
-    lo, hi = ours.get("build_ms_min"), ours.get("build_ms_max")
-    their_lo, their_hi = theirs.get("build_ms_min"), theirs.get("build_ms_max")
-    if None in (lo, hi, their_lo, their_hi) or not their_lo or not their_hi:
-        return None
-    return lo / their_hi, hi / their_lo
+def one_per_scene(lines):
+    """The lines with a build ratio, one per scene: the rows of its ray sets share its build."""
+    return list({x["scene"]: x for x in lines if x["build_ratio"] is not None}.values())
 
 
 def scorecard(rows, threads=1):
@@ -95,7 +91,7 @@ def scorecard(rows, threads=1):
             "watertight_ratio": wt["mrays_s"] / default["mrays_s"] if wt and default else None,
             "watertight_range": ratio_range(wt, default) if wt and default else None,
             "build_ratio": builder["build_ms"] / default["build_ms"] if builder and default and default["build_ms"] else None,
-            "build_range": build_range(builder, default) if builder and default else None,
+            "build_range": ratio_range(builder, default, "build_ms") if builder and default else None,
             **{k: builder.get(k) if builder else None for k in ("build_ms", "build_ms_min", "build_ms_max")},
             "agree_hit": best["agree_hit"], "same_triangle": same_triangle(best),
             "each": {b: r["mrays_s"] / embree["mrays_s"] for b, r in ours.items()},
@@ -126,15 +122,13 @@ def render_threads(rows, lines):
             base = one.get((x["scene"], x["rayset"]))
             speedup = base["build_ms"] / x["build_ms"] if base and base.get("build_ms") and x["build_ms"] else None
             if speedup and x["rayset"] == RAYSETS[0]:
-                ends = (base["build_ms_min"], base["build_ms_max"], x["build_ms_min"], x["build_ms_max"])
-                span = None if None in ends or not all(ends) else (ends[0] / ends[3], ends[1] / ends[2])
-                speedups.append({"speedup": speedup, "speedup_range": span})
+                speedups.append({"speedup": speedup, "speedup_range": ratio_range(base, x, "build_ms")})
             out.append(f"| {x['scene']} | {x['rayset']} | {x['best']} | {x['ratio']:.2f} | "
                        f"{'-' if not base else format(base['ratio'], '.2f')} | "
                        f"{'-' if x['build_ratio'] is None else format(x['build_ratio'], '.2f')} | "
                        f"{'-' if speedup is None else format(speedup, '.2f') + '×'} |")
         ratios = [x["ratio"] for x in many]
-        build_lines = list({x["scene"]: x for x in many if x["build_ratio"] is not None}.values())
+        build_lines = one_per_scene(many)
         builds = [x["build_ratio"] for x in build_lines]
         out += ["", f"Geometric mean of our best / Embree's best with {t:g} threads: {geometric_mean(ratios):.2f}."]
         if builds:
@@ -248,8 +242,7 @@ def render(lines, meta, source, rows=(), plot=None):
     per_rayset = {rs: geometric_mean([x["ratio"] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
     overall = geometric_mean(ratios)
     wts = [x["watertight_ratio"] for x in lines if x["watertight_ratio"] is not None]
-    # One build per scene: the rows of its ray sets share it.
-    build_lines = list({x["scene"]: x for x in lines if x["build_ratio"] is not None}.values())
+    build_lines = one_per_scene(lines)
     builds = [x["build_ratio"] for x in build_lines]
     out += ["", "Geometric mean of our best / Embree's best: " +
             ", ".join(f"{rs} {v:.2f}" for rs, v in per_rayset.items() if v) + (f"; all {overall:.2f}." if overall else "."),
