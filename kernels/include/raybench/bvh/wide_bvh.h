@@ -80,11 +80,15 @@ struct WideBvh {
   HugePageVector<WideNode<W>> nodes;               // nodes[0] is the root
   HugePageVector<TrianglePack<W>> packs;           // WideLeaves::kMollerTrumbore: up to W triangles each
   HugePageVector<TriangleVertices8> vertex_packs;  // WideLeaves::kVertices (W = 8): the same packs as vertices
-  HugePageVector<std::int32_t> pack_prims;         // W per pack: input triangle index, -1 in unused lanes (vertex packs carry a copy)
+  HugePageVector<std::int32_t> pack_prims;         // W per pack, at slot(): input triangle index, -1 in unused lanes
+                                                   // (vertex packs carry a copy)
   std::size_t depth = 0;                        // levels below the root; bounds the traversal stack
   // The union of the root's child boxes, which contain every box below them:
   // the extent of every plane a ray is tested against (SlabFmaRobust's).
   BBox bounds;
+
+  // Where a pack's lane is in pack_prims (its pack slot).
+  static std::uint32_t slot(std::uint32_t pack, int lane) { return W * pack + static_cast<std::uint32_t>(lane); }
 
   std::size_t memory_bytes() const {
     return nodes.size() * sizeof(WideNode<W>) + packs.size() * sizeof(TrianglePack<W>) +
