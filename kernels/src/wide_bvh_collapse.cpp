@@ -163,6 +163,7 @@ class Collapser {
   void choose_slots() {
     slots_.resize(bvh2_.nodes.size());
     cost_ = std::make_unique_for_overwrite<float[]>(bvh2_.nodes.size() * W);
+    if (lane_order_ == WideLaneOrder::kOcclusion) hit_chance_ = std::make_unique_for_overwrite<float[]>(bvh2_.nodes.size());
     choose_slots_below(0, 0);
   }
 
@@ -181,6 +182,7 @@ class Collapser {
       expect_fits_a_pack(node);
       s.as_pack = true;
       std::fill(g, g + W, area);
+      if (hit_chance_) hit_chance_[n] = leaf_hit_chance(node);
       return node.prim_count;
     }
     const std::uint32_t l = node.first_index, r = l + 1;
@@ -194,6 +196,15 @@ class Collapser {
       right();
     }
     const std::uint32_t triangles = left_triangles + right_triangles;
+    if (hit_chance_) {
+      // A ray entering this box enters a child's with the ratio of their
+      // areas (Cauchy, for convex boxes); the children's chances taken as
+      // independent.
+      const auto through = [&](std::uint32_t child) {
+        return area > 0.0f ? std::min(1.0f, bvh2_.nodes[child].bounds.half_area() / area) * hit_chance_[child] : 0.0f;
+      };
+      hit_chance_[n] = 1.0f - (1.0f - through(l)) * (1.0f - through(r));
+    }
     const float* gl = &cost_[l * W];
     const float* gr = &cost_[r * W];
     // split[k - 1]: the cheapest sharing of k >= 2 slots between the children.
@@ -223,6 +234,21 @@ class Collapser {
       }
     }
     return triangles;
+  }
+
+  // The chance that a ray entering a BVH2 leaf's box hits one of its
+  // triangles: a random line meeting a convex box meets a convex body inside
+  // it with the ratio of their surface areas (Cauchy), for a triangle twice
+  // its area over the box's, so area / half_area. Summed over the triangles
+  // (an overestimate where they overlap as seen along the ray) and capped.
+  float leaf_hit_chance(const Bvh2Node& leaf) const {
+    const float box = leaf.bounds.half_area();
+    float covered = 0.0f;
+    for (std::uint32_t k = 0; k < leaf.prim_count; ++k) {
+      const Triangle& t = triangles_[bvh2_.prim_ids[leaf.first_index + k]];
+      covered += 0.5f * length(cross(t.v1 - t.v0, t.v2 - t.v0));
+    }
+    return box > 0.0f ? std::min(1.0f, covered / box) : 0.0f;
   }
 
   // Appends the children chosen for the BVH2 subtree at `n` given `k` slots.
@@ -259,10 +285,15 @@ class Collapser {
     return index;
   }
 
-  // With WideLaneOrder::kByArea the node's lanes hold its children by
-  // decreasing box area (ties in the plan's order, the BVH2's): any-hit
-  // traversal visits the highest lane entered first, so the smallest box
-  // (wide_bvh_traverse.h says why).
+  // Any-hit traversal visits the highest lane entered first. With
+  // WideLaneOrder::kByArea the node's lanes hold its children by decreasing
+  // box area (ties in the plan's order, the BVH2's), so the smallest box is
+  // visited first (wide_bvh_traverse.h says why). With kOcclusion, by
+  // increasing hit chance per cost: given that a ray enters children A and
+  // B, visiting A first costs C_A + (1 - P_A) C_B, so A goes first when
+  // P_A / C_A > P_B / C_B (Ize & Hansen 2011), with P the subtree's hit
+  // chance and C its SAH cost per ray entering its box (the dynamic
+  // programme's cost of it in one slot).
   void fill_node(std::size_t i) {
     const Plan& p = plans_[i];
     int order[W];  // order[lane]: the plan's child in that lane
@@ -274,6 +305,16 @@ class Collapser {
         if (std::isnan(area[k])) area[k] = -std::numeric_limits<float>::infinity();
       }
       order_by_decreasing(area, p.count, order);
+    } else if (lane_order_ == WideLaneOrder::kOcclusion && hit_chance_) {  // none for a single-leaf tree
+      float lowest_first[W];  // minus the chance per cost: decreasing puts the lowest chance in lane 0
+      for (int k = 0; k < p.count; ++k) {
+        const std::uint32_t kid = p.kids[k];
+        const float area = bvh2_.nodes[kid].bounds.half_area();
+        const float cost = area > 0.0f ? cost_[kid * W] / area : 1.0f;
+        lowest_first[k] = -(hit_chance_[kid] / cost);
+        if (std::isnan(lowest_first[k])) lowest_first[k] = std::numeric_limits<float>::infinity();
+      }
+      order_by_decreasing(lowest_first, p.count, order);
     }
     BBox boxes[W];
     std::uint32_t child[W];
@@ -338,6 +379,7 @@ class Collapser {
       std::min(7, static_cast<int>(std::bit_width(bvh2_.nodes.size() / kTaskNodes)));
   std::vector<Slots> slots_;                // per BVH2 node
   std::unique_ptr<float[]> cost_;           // per BVH2 node, W entries: its subtree in at most 1..W slots
+  std::unique_ptr<float[]> hit_chance_;     // per BVH2 node, for kOcclusion only: leaf_hit_chance, combined above
   std::vector<std::uint32_t> pack_roots_;  // the BVH2 subtree of each pack
 };
 

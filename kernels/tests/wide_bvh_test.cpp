@@ -5,6 +5,7 @@
 // node orders its children far to near per octant, and traversal answers
 // exactly as testing every triangle does.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -143,11 +144,21 @@ int expect_same_hits_as_brute_force(const WideBvh<W>& bvh, const std::vector<Tri
   return hits;
 }
 
-TEST_P(WideBvhBuild, ClosestAndAnyHitMatchBruteForceInEitherLaneOrder) {
+std::string describe(WideLaneOrder lanes) {
+  switch (lanes) {
+    case WideLaneOrder::kByArea: return "lanes by area";
+    case WideLaneOrder::kBvh2: return "lanes in the BVH2's order";
+    case WideLaneOrder::kOcclusion: return "lanes by hit chance per cost";
+  }
+  return "?";
+}
+constexpr WideLaneOrder kLaneOrders[] = {WideLaneOrder::kByArea, WideLaneOrder::kBvh2, WideLaneOrder::kOcclusion};
+
+TEST_P(WideBvhBuild, ClosestAndAnyHitMatchBruteForceInEveryLaneOrder) {
   const auto tris = random_soup(4000, 2);
   for_each_width([&](auto width) {
-  for (const WideLaneOrder lanes : {WideLaneOrder::kByArea, WideLaneOrder::kBvh2}) {
-  SCOPED_TRACE(lanes == WideLaneOrder::kByArea ? "lanes by area" : "lanes in the BVH2's order");
+  for (const WideLaneOrder lanes : kLaneOrders) {
+  SCOPED_TRACE(describe(lanes));
   const auto bvh = build<width()>(tris, lanes);
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f), len(0.0f, 25.0f);
@@ -424,6 +435,72 @@ TEST_P(WideBvhBuild, ByAreaEveryNodeHoldsItsChildrenByDecreasingBoxAreaEmptyLane
       EXPECT_GT(increasing, bvh.nodes.size() / 2);
     }
   }
+  });
+}
+
+// Which of two groups of triangles each lane of the root holds: 1 for ids
+// below `first_of_second`, 2 for the others, 3 for both, 0 for an empty lane.
+template <int W>
+std::array<int, W> groups_of_root_lanes(const WideBvh<W>& bvh, std::int32_t first_of_second) {
+  std::array<int, W> groups{};
+  for (int lane = 0; lane < W; ++lane) {
+    std::vector<std::uint32_t> todo{bvh.nodes[0].child[lane]};
+    while (!todo.empty()) {
+      const std::uint32_t ref = todo.back();
+      todo.pop_back();
+      if (ref == WideBvh<W>::kEmptyChild) continue;
+      if (ref & WideBvh<W>::kLeafBit) {
+        const std::uint32_t pack = ref & ~WideBvh<W>::kLeafBit;
+        for (int i = 0; i < W; ++i)
+          if (const std::int32_t id = bvh.pack_prims[WideBvh<W>::slot(pack, i)]; id >= 0)
+            groups[lane] |= id < first_of_second ? 1 : 2;
+      } else {
+        todo.insert(todo.end(), bvh.nodes[ref].child, bvh.nodes[ref].child + W);
+      }
+    }
+  }
+  return groups;
+}
+
+// A ray entering a box that a wall fills certainly hits it; one entering a
+// box around a few small triangles at its corners likely does not. Any-hit
+// traversal visits the highest lane first: by hit chance per cost, the
+// wall's lanes come first though its boxes are the larger, which the order
+// by area visits last.
+TEST_P(WideBvhBuild, ByOcclusionTheChildrenLikeliestToEndTheRayPerCostAreVisitedFirst) {
+  std::vector<Triangle> tris;
+  // The wall: a 10 x 10 square at z = 0 in 2 x 25 triangles, ids 0-49.
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) {
+      const float x = 2.0f * i, y = 2.0f * j;
+      tris.push_back({{x, y, 0}, {x + 2, y, 0}, {x + 2, y + 2, 0}});
+      tris.push_back({{x, y, 0}, {x + 2, y + 2, 0}, {x, y + 2, 0}});
+    }
+  const auto first_sparse = static_cast<std::int32_t>(tris.size());
+  // Sparse: 16 triangles of side 0.01 at the corners of two cubes of side
+  // 0.5 off to the side, whose boxes are all smaller than the wall's pieces.
+  for (int cube = 0; cube < 2; ++cube)
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3f c = Vec3f{60.0f + 1.0f * cube + (corner & 1), static_cast<float>(corner >> 1 & 1),
+                            static_cast<float>(corner >> 2 & 1)} * 0.5f;
+      tris.push_back({c, c + Vec3f{0.01f, 0, 0}, c + Vec3f{0, 0.01f, 0}});
+    }
+  for_each_width([&](auto width) {
+    constexpr int W = width();
+    for (const WideLaneOrder lanes : {WideLaneOrder::kOcclusion, WideLaneOrder::kByArea}) {
+      SCOPED_TRACE(describe(lanes));
+      const auto groups = groups_of_root_lanes(build<W>(tris, lanes), first_sparse);
+      int lowest_wall = W, highest_wall = -1, lowest_sparse = W, highest_sparse = -1;
+      for (int lane = 0; lane < W; ++lane) {
+        ASSERT_NE(groups[lane], 3) << "a root lane holds both groups: lane " << lane;
+        if (groups[lane] == 1) lowest_wall = std::min(lowest_wall, lane), highest_wall = lane;
+        if (groups[lane] == 2) lowest_sparse = std::min(lowest_sparse, lane), highest_sparse = lane;
+      }
+      ASSERT_GE(highest_wall, 0);
+      ASSERT_GE(highest_sparse, 0);
+      if (lanes == WideLaneOrder::kOcclusion) EXPECT_GT(lowest_wall, highest_sparse);
+      else EXPECT_GT(lowest_sparse, highest_wall);
+    }
   });
 }
 

@@ -67,9 +67,14 @@ inline int far_to_near_lane(const WideNode<W>& node, int octant, int rank) {
 enum class WideLeaves { kMollerTrumbore, kVertices };
 
 // The order of a node's children in its lanes, which is the order any-hit
-// traversal visits them in (wide_bvh_traverse.h): by decreasing box area
-// (the smallest visited first), or the BVH2's own order (left before right).
-enum class WideLaneOrder { kByArea, kBvh2 };
+// traversal visits them in (wide_bvh_traverse.h), the highest lane first:
+// - kByArea: by decreasing box area, so the smallest box is visited first;
+// - kBvh2: the BVH2's own order (left before right);
+// - kOcclusion: by increasing hit chance per cost, so the child most likely
+//   to end an occlusion ray for the least work is visited first (the
+//   termination order of Ize & Hansen, "RTSAH Traversal Order for Occlusion
+//   Rays", EG 2011; wide_bvh_collapse.cpp estimates both per subtree).
+enum class WideLaneOrder { kByArea, kBvh2, kOcclusion };
 
 template <int W>
 struct WideBvh {

@@ -24,14 +24,18 @@
 // Rays", EG 2011, which smallest-first approximates). Measured on the
 // default suite's shadow rays, one thread, default build, against the
 // BVH2's order: Sponza 1.21-1.28x, Sponza-Dabrovic 1.04x, Sibenik 1.03x,
-// Conference 1.01-1.02x, bunny 1.02x, Lucy 0.99x. The quality builds keep
-// the BVH2's order, which measured better on their trees
-// (wide_bvh_backend.cpp). Cheapest subtree first (by expected SAH cost) was
-// better on Sponza-Dabrovic (1.04x) but worse on Sponza (0.84x) and Lucy
-// (0.93x); leaves first, worse everywhere. Nearest first (the octant order)
-// was 1.15x on Sponza but 0.89-0.93x on Lucy, bunny and Conference: it
-// mostly visits the surface around the ray's origin, which a shadow ray
-// leaves without hitting.
+// Conference 1.01-1.02x, bunny 1.02x, Lucy 0.99x. The quality builds order
+// their lanes by each child's chance of ending the ray per cost
+// (WideLaneOrder::kOcclusion, Ize & Hansen's termination order), which
+// measured better on their trees than the BVH2's order, and the BVH2's
+// better than smallest first (wide_bvh_backend.cpp); on the default build
+// it was not. Cheapest subtree first (by expected SAH cost) was better on
+// Sponza-Dabrovic (1.04x) but worse on Sponza (0.84x) and Lucy (0.93x);
+// leaves first, worse everywhere. Nearest first (the octant order) was
+// 1.15x on Sponza but 0.89-0.93x on Lucy, bunny and Conference: it mostly
+// visits the surface around the ray's origin, which a shadow ray leaves
+// without hitting. Farthest first was slower on all six scenes measured
+// (0.80-0.99x), with every build.
 // The leaf test and the box test are policies: WideMollerTrumbore, or
 // Bvh8Watertight (8 wide, needs WideLeaves::kVertices); SlabFma (the
 // backends' plain test: one fused multiply-add per plane, as Embree's),
