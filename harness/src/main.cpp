@@ -94,9 +94,9 @@ int run(int argc, char** argv) {
       ->delimiter(',');
   run_cmd->add_option("--threads,-t", run_threads, "Thread counts, e.g. 1,2 (default: 1)")->delimiter(',')->check(CLI::PositiveNumber);
   run_cmd->add_option("--reps", run_reps, "Timed repetitions per case; the median is reported (default: 5)")->check(CLI::PositiveNumber);
-  run_cmd->add_option("--build-reps", run_build_reps, "Timed builds per backend, interleaved across backends after one untimed build each (default: 3)")->check(CLI::PositiveNumber);
+  run_cmd->add_option("--build-reps", run_build_reps, "Timed rounds of builds per backend, interleaved across backends after one untimed build each; a build shorter than --min-time is repeated within its round (default: 3)")->check(CLI::PositiveNumber);
   run_cmd->add_option("--seed", run_seed, "Ray generation seed (default: 1)");
-  run_cmd->add_option("--min-time", run_min_time, "Minimum seconds per repetition (default: 0.05)")->check(CLI::PositiveNumber);
+  run_cmd->add_option("--min-time", run_min_time, "Minimum seconds per repetition, of a trace or of a round of builds (default: 0.05)")->check(CLI::PositiveNumber);
   run_cmd->add_option("--warmup", run_warmup, "Untimed warm-up seconds per case (default: 0.05)")->check(CLI::NonNegativeNumber);
   run_cmd->add_option("--out,-o", run_options.out_csv, "Results CSV; metadata goes beside it as .meta.toml")->capture_default_str();
   run_cmd->add_option("--rays-dir", run_options.rays_dir, "Where ray sets are stored and reused")->capture_default_str();

@@ -190,7 +190,7 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
         built.push_back(backends.back().get());
       }
       const std::vector<std::vector<double>> build_times =
-          time_builds_interleaved(built, scene, executor, settings.build_repetitions);
+          time_builds_interleaved(built, scene, executor, settings.build_repetitions, settings.min_time);
       for (std::size_t bi = 0; bi < built.size(); ++bi) {
         const std::string& backend_name = settings.backends[bi];
         const Backend* backend = built[bi];
