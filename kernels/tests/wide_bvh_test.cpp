@@ -295,16 +295,20 @@ TEST_P(WideBvhBuild, FindsTheClosedSphereFromInsideAndNothingOutsideIt) {
 TEST_P(WideBvhBuild, TheTreeIsTheSameBuiltOnOneThreadOrTwo) {
   const auto tris = random_soup(20000, 11);  // above the parallel thresholds
   for_each_width([&](auto width) {
-    constexpr int W = width();
+  constexpr int W = width();
+  // The occlusion order's hit chances are computed in the collapse's tasks too.
+  for (const WideLaneOrder lanes : {WideLaneOrder::kByArea, WideLaneOrder::kOcclusion}) {
+    SCOPED_TRACE(describe(lanes));
     WideBvh<W> one, two;
-    tbb::task_arena(1).execute([&] { one = build<W>(tris); });
-    tbb::task_arena(2).execute([&] { two = build<W>(tris); });
+    tbb::task_arena(1).execute([&] { one = build<W>(tris, lanes); });
+    tbb::task_arena(2).execute([&] { two = build<W>(tris, lanes); });
     ASSERT_EQ(one.nodes.size(), two.nodes.size());
     ASSERT_EQ(one.packs.size(), two.packs.size());
     EXPECT_EQ(one.depth, two.depth);
     EXPECT_EQ(0, std::memcmp(one.nodes.data(), two.nodes.data(), one.nodes.size() * sizeof(WideNode<W>)));
     EXPECT_EQ(0, std::memcmp(one.packs.data(), two.packs.data(), one.packs.size() * sizeof(TrianglePack<W>)));
     EXPECT_TRUE(one.pack_prims == two.pack_prims);
+  }
   });
 }
 
