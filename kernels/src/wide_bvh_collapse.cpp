@@ -371,10 +371,12 @@ class Collapser {
   std::vector<Plan> plans_;
   // BVH2 levels above parallel_depth_ are evaluated as parallel tasks: at
   // most 2^7 of them, in a balanced tree of kTaskNodes / 2 to kTaskNodes
-  // nodes each (or larger, past 2^7). Small trees stay serial: on the 3,732
-  // triangles of Wuson, tasks made the collapse slower on two threads than
-  // on one.
-  static constexpr std::size_t kTaskNodes = 2048;
+  // nodes each (or larger, past 2^7); trees of fewer than kTaskNodes nodes
+  // stay serial. At 2048 Wuson's 3,732 triangles were collapsed on one
+  // thread, which single builds had measured faster; timed as the mean of
+  // repeated builds (build_timing.h), Wuson's two-thread build is 4 % faster
+  // at 256, with the builder's smaller grain (bvh2_builder.cpp).
+  static constexpr std::size_t kTaskNodes = 256;
   const int parallel_depth_ =
       std::min(7, static_cast<int>(std::bit_width(bvh2_.nodes.size() / kTaskNodes)));
   std::vector<Slots> slots_;                // per BVH2 node

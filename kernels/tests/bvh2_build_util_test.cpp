@@ -1,0 +1,68 @@
+// Specification of the builders' shared binning (kernels/src/bvh2_build_util.h):
+// a range binned in parallel chunks gets the bins of one pass over it.
+#include "../src/bvh2_build_util.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+namespace raybench::bvh2_build {
+namespace {
+
+struct Ref {
+  BBox bounds;
+};
+
+// Random boxes in [-10, 10]^3, every 97th with a NaN coordinate, every 89th
+// a point, and a run of equal boxes (one bin's worth of ties).
+std::vector<Ref> random_refs(std::size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> pos(-10.0f, 10.0f), size(0.0f, 2.0f);
+  std::vector<Ref> refs(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3f lower{pos(rng), pos(rng), pos(rng)};
+    refs[i].bounds = {lower, lower + Vec3f{size(rng), size(rng), size(rng)}};
+    if (i % 89 == 0) refs[i].bounds.upper = lower;
+    if (i % 97 == 0) refs[i].bounds.lower[static_cast<int>(i % 3)] = std::numeric_limits<float>::quiet_NaN();
+    if (i >= n / 2 && i < n / 2 + 300) refs[i].bounds = refs[n / 2].bounds;
+  }
+  return refs;
+}
+
+bool same_float(float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+
+TEST(BinAllAxes, InParallelChunksGivesTheBinsOfOnePassForAnyThreadCount) {
+  constexpr std::size_t kBins = 16;
+  for (const std::size_t n : {2 * kBinningChunk, std::size_t{5001}, std::size_t{40000}}) {
+    SCOPED_TRACE(n);
+    const std::vector<Ref> refs = random_refs(n, static_cast<unsigned>(n));
+    const float lo[3] = {-10.0f, -9.0f, -11.0f}, scale[3] = {0.8f, 0.7f, 0.75f};
+    std::array<std::array<BBox, kBins>, 3> one_bounds{}, chunk_bounds{};
+    std::array<std::array<std::size_t, kBins>, 3> one_count{}, chunk_count{};
+    bin_all_axes<kBins>(std::span<const Ref>(refs), lo, scale, 16, one_bounds, one_count);
+    for (const int threads : {1, 2}) {
+      SCOPED_TRACE(threads);
+      tbb::task_arena(threads).execute([&] {
+        bin_all_axes_in_chunks<kBins>(std::span<const Ref>(refs), lo, scale, 16, chunk_bounds, chunk_count);
+      });
+      std::size_t total = 0;
+      for (int axis = 0; axis < 3; ++axis)
+        for (std::size_t b = 0; b < kBins; ++b) {
+          EXPECT_EQ(chunk_count[axis][b], one_count[axis][b]) << "axis " << axis << " bin " << b;
+          total += chunk_count[axis][b];
+          for (int k = 0; k < 3; ++k) {
+            EXPECT_TRUE(same_float(chunk_bounds[axis][b].lower[k], one_bounds[axis][b].lower[k])) << axis << " " << b;
+            EXPECT_TRUE(same_float(chunk_bounds[axis][b].upper[k], one_bounds[axis][b].upper[k])) << axis << " " << b;
+          }
+        }
+      EXPECT_EQ(total, 3 * n) << "every reference binned once per axis";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace raybench::bvh2_build
