@@ -133,10 +133,13 @@ class Collapser {
     out_.pack_prims.resize(pack_roots_.size() * W);
     if (leaves_ == WideLeaves::kVertices) out_.vertex_packs.resize(pack_roots_.size());
     else out_.packs.resize(pack_roots_.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, plans_.size(), 1024), [&](const auto& r) {
+    // Small grains: a small mesh's hundred nodes and few hundred packs are
+    // filled on both threads too (Wuson's two-thread build 6 % faster than
+    // with grains of 1024, which left them to one thread).
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, plans_.size(), 64), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) fill_node(i);
     });
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pack_roots_.size(), 1024), [&](const auto& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pack_roots_.size(), 128), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) fill_pack(i);
     });
   }
