@@ -16,7 +16,7 @@ Ratios are within the run, so they travel between machines; the run's metadata n
 machine. When the CSV has each median's min and max over the repetitions, every ratio gets its
 range too (ours at its slowest / Embree at its fastest, and the reverse), and a ratio below a
 target is said to be within that noise or beyond it; the verdict stays the median's. Build times
-likewise, from their min and max over the timed builds (a build ratio above 1.0, or a build no
+likewise, from their min and max over the timing rounds (a build ratio above 1.0, or a build no
 faster with more threads, is said to be within their range or beyond it).
 Prints Markdown (or writes --out). With --out, a picture of the ratios (PNG beside it, or
 --plot) is drawn and linked from the Markdown. Bad input: one line on stderr, exit 2.
