@@ -236,7 +236,7 @@ TEST_P(WideBvhBuild, WatertightLeavesMatchTheScalarWatertightTestOnEveryRayKind)
   EXPECT_FALSE(bvh.vertex_packs.empty());
   // Each pack's own triangle indices, which the traversal reports, are pack_prims'.
   for (std::size_t pack = 0; pack < bvh.vertex_packs.size(); ++pack)
-    for (int lane = 0; lane < 8; ++lane) EXPECT_EQ(bvh.vertex_packs[pack].prim[lane], bvh.pack_prims[8 * pack + lane]);
+    for (int lane = 0; lane < 8; ++lane) EXPECT_EQ(bvh.vertex_packs[pack].prim[lane], bvh.pack_prims[Bvh8::slot(static_cast<std::uint32_t>(pack), lane)]);
   unsigned seed = 40;
   for (std::string_view kind : testing::kRayKinds) {
     SCOPED_TRACE(std::string(kind));
