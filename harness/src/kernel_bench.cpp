@@ -243,16 +243,18 @@ void add_batched(std::vector<Case>& cases, std::size_t pairs) {
   for (const bool hit : {true, false}) {
     auto tri = make_pairs<TriangleFamily>(rays, 8, hit, hash_string("triangle8") ^ hit);
     auto tri_rays = std::make_shared<std::vector<Ray>>(tri.rays);
-    auto packs = std::make_shared<std::vector<Triangle8>>();
-    for (std::size_t i = 0; i < rays; ++i) packs->push_back(Triangle8::pack({tri.prims.data() + 8 * i, 8}));
     auto box = make_pairs<BoxFamily>(rays, 8, hit, hash_string("box8") ^ hit);
     auto box_rays = std::make_shared<std::vector<Ray>>(box.rays);
     auto boxes = std::make_shared<std::vector<BBox8>>();
     for (std::size_t i = 0; i < rays; ++i) boxes->push_back(BBox8::pack({box.prims.data() + 8 * i, 8}));
 
-    const auto triangle_case = [&](const char* form, int (*fn)(const Ray&, float, const Triangle8&, TriangleHit&)) {
+    // Packs of the leaves' two forms: stored normals (mt_normal) or edges
+    // only (mt_edges, the normal recomputed per test).
+    const auto triangle_case = [&]<typename Pack>(const char* form, int (*fn)(const Ray&, float, const Pack&, TriangleHit&)) {
+      auto packs = std::make_shared<std::vector<Pack>>();
+      for (std::size_t i = 0; i < rays; ++i) packs->push_back(Pack::pack({tri.prims.data() + 8 * i, 8}));
       Case c;
-      c.result = describe("triangle", "mt_normal", form, hit, "fast", 8 * rays);
+      c.result = describe("triangle", std::string(Pack::Kernel::name), form, hit, "fast", 8 * rays);
       c.run = [tri_rays, packs, fn] {
         std::size_t hits = 0;
         // One closest-hit call per ray, as a BVH leaf makes it; it reports
@@ -277,10 +279,12 @@ void add_batched(std::vector<Case>& cases, std::size_t pairs) {
       };
       cases.push_back(std::move(c));
     };
-    triangle_case("scalar_x8", intersect_pack_scalar<8>);
+    triangle_case("scalar_x8", intersect_pack_scalar<Triangle8>);
+    triangle_case("scalar_x8", intersect_pack_scalar<TriangleEdgePack<8>>);
     box_case("scalar_x8", intersect_boxes_scalar<Slab, 8>);
 #if defined(__AVX2__)
-    triangle_case("avx2_x8", intersect_pack_simd<8>);
+    triangle_case("avx2_x8", intersect_pack_simd<Triangle8>);
+    triangle_case("avx2_x8", intersect_pack_simd<TriangleEdgePack<8>>);
     box_case("avx2_x8", intersect_boxes_simd<Slab, 8>);
 #endif
   }

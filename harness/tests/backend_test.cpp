@@ -190,7 +190,7 @@ TEST(BackendNames, EveryTriangleTestIsABvh2Backend) {
   std::vector<std::string> names;
   for (const BackendInfo& b : list_backends()) names.push_back(b.name);
   for (const char* n : {"bvh2:mt", "bvh2:mt_seed", "bvh2:watertight", "bvh2:baldwin_weber", "bvh2:mt_double",
-                        "bvh2:watertight:robust"})
+                        "bvh2:mt_edges", "bvh2:watertight:robust"})
     EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
 }
 
@@ -209,6 +209,7 @@ TEST(BackendNames, UnknownFamiliesAndOptionsAreErrorsThatSaySo) {
   EXPECT_NO_THROW(make_backend("bvh8:watertight:robust:lbvh"));
   EXPECT_NE(error_of("bvh8:mt_seed").find("unknown option 'mt_seed'"), std::string::npos);  // no 8-wide seed kernel
   EXPECT_NE(error_of("bvh8:mt:watertight").find("each at most once"), std::string::npos);
+  EXPECT_NE(error_of("bvh8:mt_edges:watertight").find("each at most once"), std::string::npos);
   EXPECT_NE(error_of("bvh8:lbvh:sweep").find("each at most once"), std::string::npos);
   EXPECT_NE(error_of("bvh2:reinsert:sweep:reinsert").find("each at most once"), std::string::npos);
   EXPECT_NE(error_of("bvh8:reinsert:reinsert").find("each at most once"), std::string::npos);
@@ -228,7 +229,8 @@ TEST(BackendNames, BuildersAreOptionsOfBvh2AndBvh8InAnyOrder) {
   for (const char* n : {"bvh2:sweep", "bvh2:lbvh", "bvh8:sweep", "bvh8:lbvh"})
     EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
   for (const char* n : {"bvh2:binned", "bvh2:watertight:robust:sweep", "bvh2:lbvh:watertight:robust",
-                        "bvh2:robust:sweep:mt", "bvh8:binned", "bvh8:mt:lbvh", "bvh8:sweep:mt"})
+                        "bvh2:robust:sweep:mt", "bvh8:binned", "bvh8:mt:lbvh", "bvh8:sweep:mt", "bvh8:mt_edges:sbvh",
+                        "bvh4:reinsert:mt_edges"})
     EXPECT_EQ(make_backend(n)->name(), n);
   // The builder changes the tree, not the accuracy class, wherever it stands.
   EXPECT_EQ(backend_accuracy_class("bvh2:sweep:watertight:robust"), "watertight");
@@ -285,7 +287,8 @@ TEST(Builders, EveryBuilderGivesTheSameHitsAsTheDefaultBuild) {
            {"bvh2", {"bvh2:binned", "bvh2:sweep", "bvh2:lbvh", "bvh2:sbvh", "bvh2:reinsert", "bvh2:sbvh:reinsert"}},
            {"bvh2:watertight:robust",
             {"bvh2:watertight:robust:sweep", "bvh2:lbvh:watertight:robust", "bvh2:reinsert:sbvh:watertight:robust"}},
-           {"bvh8", {"bvh8:sweep", "bvh8:lbvh", "bvh2:sweep:mt_normal", "bvh8:sbvh", "bvh8:reinsert"}}}) {
+           {"bvh8", {"bvh8:sweep", "bvh8:lbvh", "bvh2:sweep:mt_normal", "bvh8:sbvh", "bvh8:reinsert"}},
+           {"bvh2:mt_edges", {"bvh8:mt_edges", "bvh4:mt_edges", "bvh8:mt_edges:sbvh:reinsert"}}}) {
     const auto reference = make_backend(base);
     reference->build(scene);
     std::vector<Hit> expected(rays.size());

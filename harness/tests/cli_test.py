@@ -445,7 +445,7 @@ class KernelMicrobenchmarks(CliTestCase):
         with open(out) as f:
             rows = list(csv.DictReader(f))
         names = {(r["family"], r["variant"], r["form"], r["input"]) for r in rows}
-        variants = {"triangle": ["mt", "mt_seed", "watertight", "baldwin_weber", "mt_double", "mt_normal"],
+        variants = {"triangle": ["mt", "mt_seed", "watertight", "baldwin_weber", "mt_double", "mt_normal", "mt_edges"],
                     "box": ["slab", "slab_seed", "slab_robust"],
                     "sphere": ["sphere_seed", "sphere_quadratic", "sphere_precise"],
                     "obb": ["obb", "obb_seed"]}
@@ -453,7 +453,7 @@ class KernelMicrobenchmarks(CliTestCase):
             for variant in members:
                 for kind in ("hit", "miss"):
                     self.assertIn((family, variant, "scalar", kind), names)
-        for family, variant in (("triangle", "mt_normal"), ("box", "slab")):
+        for family, variant in (("triangle", "mt_normal"), ("triangle", "mt_edges"), ("box", "slab")):
             for kind in ("hit", "miss"):
                 self.assertIn((family, variant, "scalar_x8", kind), names)
         for row in rows:

@@ -131,8 +131,11 @@ class Collapser {
     }
     out_.nodes.resize(plans_.size());
     out_.pack_prims.resize(pack_roots_.size() * W);
-    if (leaves_ == WideLeaves::kVertices) out_.vertex_packs.resize(pack_roots_.size());
-    else out_.packs.resize(pack_roots_.size());
+    switch (leaves_) {
+      case WideLeaves::kMollerTrumbore: out_.packs.resize(pack_roots_.size()); break;
+      case WideLeaves::kMollerTrumboreEdges: out_.edge_packs.resize(pack_roots_.size()); break;
+      case WideLeaves::kVertices: out_.vertex_packs.resize(pack_roots_.size()); break;
+    }
     // Small grains: a small mesh's hundred nodes and few hundred packs are
     // filled on both threads too (Wuson's two-thread build 6 % faster than
     // with grains of 1024, which left them to one thread).
@@ -353,11 +356,12 @@ class Collapser {
     Triangle tris[W];
     for (std::uint32_t k = 0; k < count; ++k) tris[k] = triangles_[ids[k]];
     const std::span<const Triangle> used(tris, count);
-    if constexpr (W == 8) {
-      if (leaves_ == WideLeaves::kVertices) out_.vertex_packs[i] = TriangleVertices8::pack(used);
-      else out_.packs[i] = TrianglePack<W>::pack(used);
-    } else {
-      out_.packs[i] = TrianglePack<W>::pack(used);
+    switch (leaves_) {
+      case WideLeaves::kMollerTrumbore: out_.packs[i] = TrianglePack<W>::pack(used); break;
+      case WideLeaves::kMollerTrumboreEdges: out_.edge_packs[i] = TriangleEdgePack<W>::pack(used); break;
+      case WideLeaves::kVertices:
+        if constexpr (W == 8) out_.vertex_packs[i] = TriangleVertices8::pack(used);
+        break;
     }
     for (std::uint32_t k = 0; k < W; ++k)
       out_.pack_prims[i * W + k] = k < count ? static_cast<std::int32_t>(ids[k]) : -1;

@@ -33,7 +33,8 @@ bool hits(const Ray& r, const Triangle& tri, TriangleHit* out = nullptr, float t
 template <typename Test>
 class CorrectTriangleTest : public ::testing::Test {};
 using CorrectTests =
-    ::testing::Types<MollerTrumbore, WatertightTriangle, BaldwinWeber, MollerTrumboreDouble, MollerTrumboreNormal>;
+    ::testing::Types<MollerTrumbore, WatertightTriangle, BaldwinWeber, MollerTrumboreDouble, MollerTrumboreNormal,
+                     MollerTrumboreEdges>;
 TYPED_TEST_SUITE(CorrectTriangleTest, CorrectTests);
 
 TYPED_TEST(CorrectTriangleTest, HitReportsDistanceAndBarycentrics) {

@@ -36,11 +36,12 @@ class WideBvhBuild : public ::testing::TestWithParam<Bvh2Builder> {
   // of at most W triangles, scored as scalar tests, gathered into packs by
   // the collapse. The watertight tests below build as the default does.
   template <int W = 8>
-  WideBvh<W> build(const std::vector<Triangle>& tris, WideLaneOrder lanes = WideLaneOrder::kByArea) const {
+  WideBvh<W> build(const std::vector<Triangle>& tris, WideLaneOrder lanes = WideLaneOrder::kByArea,
+                   WideLeaves leaves = WideLeaves::kMollerTrumbore) const {
     Bvh2BuildOptions options;
     options.leaf_granularity = 1;
     options.max_leaf_size = W;
-    return collapse_bvh2<W>(build_bvh2(tris, GetParam(), options), tris, WideLeaves::kMollerTrumbore, lanes);
+    return collapse_bvh2<W>(build_bvh2(tris, GetParam(), options), tris, leaves, lanes);
   }
   // Runs body(std::integral_constant<int, W>) for both widths.
   template <typename Body>
@@ -120,18 +121,20 @@ TEST_P(WideBvhBuild, EveryTriangleInALeafUnderBoundsThatContainItOrTogetherCover
 }
 
 // Closest and any hit of every ray against brute force with the leaves'
-// own triangle test (Möller–Trumbore in its stored-normal form); returns
+// own triangle test (Möller–Trumbore in its stored-normal form, or for
+// WideMollerTrumboreEdges the same with the normal recomputed); returns
 // the number of rays that hit. Exact ties in t may name either triangle.
-template <int W>
+template <typename Leaf = WideMollerTrumbore, int W>
 int expect_same_hits_as_brute_force(const WideBvh<W>& bvh, const std::vector<Triangle>& tris,
                                     const std::vector<Ray>& rays) {
+  using Kernel = std::conditional_t<std::is_same_v<Leaf, WideMollerTrumboreEdges>, MollerTrumboreEdges, MollerTrumboreNormal>;
   int hits = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
     const Ray& r = rays[i];
-    const Hit expected = brute_force_closest<MollerTrumboreNormal>(tris, r);
-    const Hit got = intersect_wide(bvh, r);
+    const Hit expected = brute_force_closest<Kernel>(tris, r);
+    const Hit got = intersect_wide<Leaf>(bvh, r);
     EXPECT_EQ(got.hit(), expected.hit()) << "ray " << i;
-    EXPECT_EQ(occluded_wide(bvh, r), expected.hit()) << "ray " << i;
+    EXPECT_EQ(occluded_wide<Leaf>(bvh, r), expected.hit()) << "ray " << i;
     if (!expected.hit() || !got.hit()) continue;
     ++hits;
     EXPECT_EQ(got.t, expected.t) << "ray " << i;
@@ -182,6 +185,29 @@ TEST_P(WideBvhBuild, EveryRayKindOnAMeshMatchesBruteForce) {
       SCOPED_TRACE(std::string(kind));
       const int hits = expect_same_hits_as_brute_force(bvh, tris, testing::rays_at(tris, kind, 2000, seed++));
       EXPECT_GT(hits, 100);
+    }
+  });
+}
+
+// Leaves without normals (WideLeaves::kMollerTrumboreEdges) hold the same
+// triangles in packs of 9 floats per triangle instead of 12, and their test
+// answers as its scalar kernel (prim/triangle_mt_edges.h) does by brute force.
+TEST_P(WideBvhBuild, EdgeLeavesAreAQuarterSmallerAndMatchTheirScalarTestOnEveryRayKind) {
+  const auto tris = testing::sphere_cluster();
+  for_each_width([&](auto width) {
+    constexpr int W = width();
+    const auto stored = build<W>(tris);
+    const auto edges = build<W>(tris, WideLaneOrder::kByArea, WideLeaves::kMollerTrumboreEdges);
+    EXPECT_TRUE(edges.packs.empty());
+    ASSERT_EQ(edges.edge_packs.size(), stored.packs.size());
+    EXPECT_TRUE(edges.pack_prims == stored.pack_prims);  // the same triangles in the same packs
+    EXPECT_EQ(4 * sizeof(TriangleEdgePack<W>), 3 * sizeof(TrianglePack<W>));
+    EXPECT_LT(edges.memory_bytes(), stored.memory_bytes());
+    unsigned seed = 40;
+    for (std::string_view kind : testing::kRayKinds) {
+      SCOPED_TRACE(std::string(kind));
+      EXPECT_GT(expect_same_hits_as_brute_force<WideMollerTrumboreEdges>(edges, tris, testing::rays_at(tris, kind, 2000, seed++)),
+                100);
     }
   });
 }

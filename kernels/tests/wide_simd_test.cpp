@@ -89,16 +89,24 @@ void expect_simd_answers_as_scalar(unsigned seed, bool edge_cases, int width, Si
   EXPECT_GT(hits, 5000);
 }
 
-template <int W>
+template <typename Pack>
 void expect_triangle_pack_simd_equals_scalar() {
-  expect_simd_answers_as_scalar<TrianglePack<W>>(
-      1, false, W,
-      [](const RandomPack& c, const TrianglePack<W>& p, TriangleHit& h) { return intersect_pack_simd(c.ray, c.tmax, p, h); },
-      [](const RandomPack& c, const TrianglePack<W>& p, TriangleHit& h) { return intersect_pack_scalar(c.ray, c.tmax, p, h); });
+  expect_simd_answers_as_scalar<Pack>(
+      1, false, Pack::kWidth,
+      [](const RandomPack& c, const Pack& p, TriangleHit& h) { return intersect_pack_simd(c.ray, c.tmax, p, h); },
+      [](const RandomPack& c, const Pack& p, TriangleHit& h) { return intersect_pack_scalar(c.ray, c.tmax, p, h); });
 }
 
-TEST(TrianglePack, Avx2AnswersExactlyAsTheScalarKernel) { expect_triangle_pack_simd_equals_scalar<8>(); }
-TEST(TrianglePack, SseFourWideAnswersExactlyAsTheScalarKernel) { expect_triangle_pack_simd_equals_scalar<4>(); }
+TEST(TrianglePack, Avx2AnswersExactlyAsTheScalarKernel) { expect_triangle_pack_simd_equals_scalar<TrianglePack<8>>(); }
+TEST(TrianglePack, SseFourWideAnswersExactlyAsTheScalarKernel) { expect_triangle_pack_simd_equals_scalar<TrianglePack<4>>(); }
+// Without stored normals the SIMD form recomputes each lane's normal with
+// the scalar kernel's fused operations (prim/triangle_mt_edges.h).
+TEST(TriangleEdgePack, Avx2AnswersExactlyAsTheScalarKernel) {
+  expect_triangle_pack_simd_equals_scalar<TriangleEdgePack<8>>();
+}
+TEST(TriangleEdgePack, SseFourWideAnswersExactlyAsTheScalarKernel) {
+  expect_triangle_pack_simd_equals_scalar<TriangleEdgePack<4>>();
+}
 
 template <typename BoxTest, int W>
 void expect_boxes_simd_equals_scalar() {

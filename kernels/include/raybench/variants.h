@@ -21,6 +21,7 @@
 #include "raybench/prim/triangle_baldwin_weber.h"
 #include "raybench/prim/triangle_mt.h"
 #include "raybench/prim/triangle_mt_double.h"
+#include "raybench/prim/triangle_mt_edges.h"
 #include "raybench/prim/triangle_mt_normal.h"
 #include "raybench/prim/triangle_mt_seed.h"
 #include "raybench/prim/triangle_watertight.h"
@@ -30,7 +31,7 @@ namespace raybench {
 // The first entry is the default test of every BVH backend.
 using TriangleTests =
     std::tuple<MollerTrumbore, MollerTrumboreSeed, WatertightTriangle, BaldwinWeber, MollerTrumboreDouble,
-               MollerTrumboreNormal>;
+               MollerTrumboreNormal, MollerTrumboreEdges>;
 
 // Ray-box tests (seed 000), ray-sphere tests (seed 003), ray-OBB tests
 // (seed 004). The microbenchmarks (raybench kernels) time every entry.

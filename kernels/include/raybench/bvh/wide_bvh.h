@@ -60,11 +60,12 @@ inline int far_to_near_lane(const WideNode<W>& node, int octant, int rank) {
   return static_cast<int>(static_cast<std::uint32_t>(node.far_to_near[octant]) >> (bits * rank) & ((1u << bits) - 1));
 }
 
-// What a leaf pack stores: Möller–Trumbore's v0, e1, e2 (TrianglePack), or
-// the triangles' own vertices for the watertight test (TriangleVertices8,
-// 8-wide only: the edges must not be rounded, or shared edges would no
-// longer match).
-enum class WideLeaves { kMollerTrumbore, kVertices };
+// What a leaf pack stores: Möller–Trumbore's v0, e1, e2 and normal
+// (TrianglePack), the same without the normal, recomputed per test
+// (TriangleEdgePack: a quarter less memory), or the triangles' own vertices
+// for the watertight test (TriangleVertices8, 8-wide only: the edges must
+// not be rounded, or shared edges would no longer match).
+enum class WideLeaves { kMollerTrumbore, kMollerTrumboreEdges, kVertices };
 
 // The order of a node's children in its lanes, which is the order any-hit
 // traversal visits them in (wide_bvh_traverse.h), the highest lane first:
@@ -84,6 +85,7 @@ struct WideBvh {
 
   HugePageVector<WideNode<W>> nodes;               // nodes[0] is the root
   HugePageVector<TrianglePack<W>> packs;           // WideLeaves::kMollerTrumbore: up to W triangles each
+  HugePageVector<TriangleEdgePack<W>> edge_packs;  // WideLeaves::kMollerTrumboreEdges: the same packs without normals
   HugePageVector<TriangleVertices8> vertex_packs;  // WideLeaves::kVertices (W = 8): the same packs as vertices
   HugePageVector<std::int32_t> pack_prims;         // W per pack, at slot(): input triangle index, -1 in unused lanes
                                                    // (vertex packs carry a copy)
@@ -97,7 +99,8 @@ struct WideBvh {
 
   std::size_t memory_bytes() const {
     return nodes.size() * sizeof(WideNode<W>) + packs.size() * sizeof(TrianglePack<W>) +
-           vertex_packs.size() * sizeof(TriangleVertices8) + pack_prims.size() * sizeof(std::int32_t);
+           edge_packs.size() * sizeof(TriangleEdgePack<W>) + vertex_packs.size() * sizeof(TriangleVertices8) +
+           pack_prims.size() * sizeof(std::int32_t);
   }
   // Surface-area-heuristic cost of the wide tree, relative to the root's
   // area: visiting a node (one W-box test) and testing a pack (one W-triangle

@@ -9,7 +9,9 @@
 // Measured against the plain Möller–Trumbore form (two cross products, one
 // division per pack), same trees and rays, one thread: 2-5 % more rays per
 // second through bvh8 on Sponza-Dabrovic and the bunny, for 33 % more leaf
-// memory (12 floats per triangle instead of 9).
+// memory (12 floats per triangle instead of 9). TriangleEdgePack stores the
+// 9 (prim/triangle_mt_edges.h) and recomputes the normal per test, for
+// scenes whose leaves do not fit in the caches.
 #pragma once
 
 #include <array>
@@ -20,6 +22,7 @@
 #include "raybench/math/inline.h"
 #include "raybench/math/ray.h"
 #include "raybench/prim/triangle.h"
+#include "raybench/prim/triangle_mt_edges.h"
 #include "raybench/prim/triangle_mt_normal.h"
 #include "raybench/simd/lanes.h"
 
@@ -32,46 +35,72 @@ inline constexpr bool kHaveAvx2 =
     false;
 #endif
 
+// Fills a pack's lanes with Pack::Kernel::prepare of up to W triangles;
+// missing lanes get NaN and never hit.
+template <typename Pack>
+Pack pack_triangle_lanes(std::span<const Triangle> tris) {
+  using Prepared = typename Pack::Kernel::Prepared;
+  constexpr int W = Pack::kWidth;
+  Pack p;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int lane = 0; lane < W; ++lane) {
+    const bool used = lane < static_cast<int>(tris.size());
+    const Prepared t = used ? Pack::Kernel::prepare(tris[lane]) : Prepared{};
+    const auto put = [&](float (&x)[3][W], const Vec3f& v) {
+      for (int a = 0; a < 3; ++a) x[a][lane] = used ? v[a] : nan;
+    };
+    put(p.v0, t.v0);
+    put(p.e1, t.e1);
+    put(p.e2, t.e2);
+    if constexpr (requires { p.normal; }) put(p.normal, t.normal);
+  }
+  return p;
+}
+
+// Lane i of a pack as its scalar kernel's Prepared triangle.
+template <typename Pack>
+typename Pack::Kernel::Prepared triangle_lane(const Pack& p, int i) {
+  constexpr int W = Pack::kWidth;
+  const auto at = [&](const float (&x)[3][W]) { return Vec3f{x[0][i], x[1][i], x[2][i]}; };
+  if constexpr (requires { p.normal; }) return {at(p.v0), at(p.e1), at(p.e2), at(p.normal)};
+  else return {at(p.v0), at(p.e1), at(p.e2)};
+}
+
 template <int W>
 struct alignas(4 * W) TrianglePack {
   static constexpr int kWidth = W;
+  using Kernel = MollerTrumboreNormal;
   // MollerTrumboreNormal::Prepared, lane by lane.
   float v0[3][W], e1[3][W], e2[3][W], normal[3][W];
 
   // Packs up to W triangles; missing lanes get NaN and never hit.
-  static TrianglePack pack(std::span<const Triangle> tris) {
-    TrianglePack p;
-    const float nan = std::numeric_limits<float>::quiet_NaN();
-    for (int lane = 0; lane < W; ++lane) {
-      const bool used = lane < static_cast<int>(tris.size());
-      const MollerTrumboreNormal::Prepared t = used ? MollerTrumboreNormal::prepare(tris[lane]) : MollerTrumboreNormal::Prepared{};
-      for (int a = 0; a < 3; ++a) {
-        p.v0[a][lane] = used ? t.v0[a] : nan;
-        p.e1[a][lane] = used ? t.e1[a] : nan;
-        p.e2[a][lane] = used ? t.e2[a] : nan;
-        p.normal[a][lane] = used ? t.normal[a] : nan;
-      }
-    }
-    return p;
-  }
-
-  MollerTrumboreNormal::Prepared lane(int i) const {
-    const auto at = [&](const float (&x)[3][W]) { return Vec3f{x[0][i], x[1][i], x[2][i]}; };
-    return {at(v0), at(e1), at(e2), at(normal)};
-  }
+  static TrianglePack pack(std::span<const Triangle> tris) { return pack_triangle_lanes<TrianglePack>(tris); }
+  Kernel::Prepared lane(int i) const { return triangle_lane(*this, i); }
 };
 using Triangle8 = TrianglePack<8>;
 using Triangle4 = TrianglePack<4>;
 
+// The same test with the normal recomputed from the edges per test
+// (prim/triangle_mt_edges.h): 9 floats per triangle instead of 12.
+template <int W>
+struct alignas(4 * W) TriangleEdgePack {
+  static constexpr int kWidth = W;
+  using Kernel = MollerTrumboreEdges;
+  float v0[3][W], e1[3][W], e2[3][W];
+
+  static TriangleEdgePack pack(std::span<const Triangle> tris) { return pack_triangle_lanes<TriangleEdgePack>(tris); }
+  Kernel::Prepared lane(int i) const { return triangle_lane(*this, i); }
+};
+
 // The scalar form: lane by lane with the scalar kernel. Returns the lane of
 // the closest hit in (tnear, tmax], or -1. On equal t the last such lane
 // wins: tmax is inclusive, so a later lane at the same t replaces the hit.
-template <int W>
-inline int intersect_pack_scalar(const Ray& ray, float tmax, const TrianglePack<W>& t, TriangleHit& out) {
+template <typename Pack>
+inline int intersect_pack_scalar(const Ray& ray, float tmax, const Pack& t, TriangleHit& out) {
   int best = -1;
-  for (int lane = 0; lane < W; ++lane) {
+  for (int lane = 0; lane < Pack::kWidth; ++lane) {
     TriangleHit h;
-    if (MollerTrumboreNormal::intersect(ray, tmax, t.lane(lane), h)) {
+    if (Pack::Kernel::intersect(ray, tmax, t.lane(lane), h)) {
       tmax = h.t;
       out = h;
       best = lane;
@@ -81,15 +110,25 @@ inline int intersect_pack_scalar(const Ray& ray, float tmax, const TrianglePack<
 }
 
 #if defined(__AVX2__)
-template <int W>
-RAYBENCH_INLINE int intersect_pack_simd(const Ray& ray, float tmax, const TrianglePack<W>& t, TriangleHit& out) {
+template <typename Pack>
+RAYBENCH_INLINE int intersect_pack_simd(const Ray& ray, float tmax, const Pack& t, TriangleHit& out) {
+  constexpr int W = Pack::kWidth;
   using F = simd::FloatLanes<W>;
   const auto load3 = [](const float (&x)[3][W]) { return std::array<F, 3>{F::load(x[0]), F::load(x[1]), F::load(x[2])}; };
   const auto dot = [](const std::array<F, 3>& a, const std::array<F, 3>& b) {  // MollerTrumboreNormal::dot_fma
     return fmadd(a[0], b[0], fmadd(a[1], b[1], a[2] * b[2]));
   };
   const std::array<F, 3> d{F::set1(ray.dir.x), F::set1(ray.dir.y), F::set1(ray.dir.z)};
-  const std::array<F, 3> normal = load3(t.normal);
+  // Stored, or MollerTrumboreEdges::normal lane by lane.
+  const std::array<F, 3> normal = [&] {
+    if constexpr (requires { t.normal; }) {
+      return load3(t.normal);
+    } else {
+      const std::array<F, 3> e1 = load3(t.e1), e2 = load3(t.e2);
+      return std::array<F, 3>{fmsub(e1[1], e2[2], e1[2] * e2[1]), fmsub(e1[2], e2[0], e1[0] * e2[2]),
+                              fmsub(e1[0], e2[1], e1[1] * e2[0])};
+    }
+  }();
   const std::array<F, 3> c{F::load(t.v0[0]) - F::set1(ray.org.x), F::load(t.v0[1]) - F::set1(ray.org.y),
                            F::load(t.v0[2]) - F::set1(ray.org.z)};
   const std::array<F, 3> r{fmsub(d[1], c[2], d[2] * c[1]), fmsub(d[2], c[0], d[0] * c[2]), fmsub(d[0], c[1], d[1] * c[0])};
@@ -126,8 +165,8 @@ RAYBENCH_INLINE int intersect_pack_simd(const Ray& ray, float tmax, const Triang
 // the traversal loop: called, it would spill and reload the ray's SIMD
 // registers around every leaf (all of them are caller-saved), measured to
 // cost bvh8 13-20 % on shadow rays.
-template <int W>
-RAYBENCH_INLINE int intersect_pack(const Ray& ray, float tmax, const TrianglePack<W>& t, TriangleHit& out) {
+template <typename Pack>
+RAYBENCH_INLINE int intersect_pack(const Ray& ray, float tmax, const Pack& t, TriangleHit& out) {
 #if defined(__AVX2__)
   return intersect_pack_simd(ray, tmax, t, out);
 #else
