@@ -4,6 +4,7 @@
 // right triangle v0 = (0,0,0), v1 = (1,0,0), v2 = (0,1,0) in the plane z = 0.
 #include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -172,6 +173,40 @@ TEST(MollerTrumbore, KnownFailure_LeaksThroughSharedEdgesOfAClosedMesh) {
   const int leaks = leaks_from_inside_sphere<MollerTrumbore>({0, 0, 0}, 1.0f);
   EXPECT_GT(leaks, 0);
   RecordProperty("mt_leaks_of_8832_rays", leaks);
+}
+
+TEST(MollerTrumboreEdges, KnownFailure_ItsFloatNormalLetsRaysHitCollinearTriangles) {
+  // G08's exactly collinear integer triangle (EXTREMES.md) has no area:
+  // mt_normal's normal, computed in double from its float edges (whose
+  // products are exact there), is exactly zero and every ray misses it;
+  // mt_edges' float normal keeps the rounding of one product per component
+  // (5000 * 12439 needs 26 bits), and some rays aimed at the segment hit.
+  const Vec3f p[3] = {{0, 0, 0}, {3000, 5000, 7000}, {5331, 8885, 12439}};
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), along(0.0f, 1.0f), away(1e3f, 1e4f);
+  int edge_hits = 0, normal_hits = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const int r = i % 3;
+    const Triangle seg{p[r], p[(r + 1) % 3], p[(r + 2) % 3]};
+    const Vec3f target = p[0] + (p[2] - p[0]) * along(rng);
+    const Vec3f org = target + normalize(Vec3f{u(rng), u(rng), u(rng)}) * away(rng);
+    const Ray shot = ray(org, target - org);
+    edge_hits += hits<MollerTrumboreEdges>(shot, seg);
+    normal_hits += hits<MollerTrumboreNormal>(shot, seg);
+  }
+  int float_normals_not_zero = 0;  // of the three vertex orders
+  for (int r = 0; r < 3; ++r) {
+    const Triangle seg{p[r], p[(r + 1) % 3], p[(r + 2) % 3]};
+    const MollerTrumboreEdges::Prepared prepared = MollerTrumboreEdges::prepare(seg);
+    const Vec3f n = MollerTrumboreEdges::normal(prepared.e1, prepared.e2);
+    float_normals_not_zero += n.x != 0.0f || n.y != 0.0f || n.z != 0.0f;
+    const Vec3f exact = MollerTrumboreNormal::prepare(seg).normal;
+    EXPECT_TRUE(exact.x == 0.0f && exact.y == 0.0f && exact.z == 0.0f) << r;
+  }
+  EXPECT_GT(float_normals_not_zero, 0);
+  EXPECT_EQ(normal_hits, 0);
+  EXPECT_GT(edge_hits, 0);
+  RecordProperty("mt_edges_hits_of_4000_rays_at_a_collinear_triangle", edge_hits);
 }
 
 // --- Seed 002 as written: where it breaks, and the fixed variant beside it ----
