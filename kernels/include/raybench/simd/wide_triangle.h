@@ -35,6 +35,11 @@ inline constexpr bool kHaveAvx2 =
     false;
 #endif
 
+// Whether a pack stores its triangles' normals (TrianglePack) or leaves
+// them to the test (TriangleEdgePack).
+template <typename Pack>
+concept StoresNormals = requires(const Pack& p) { p.normal; };
+
 // Fills a pack's lanes with Pack::Kernel::prepare of up to W triangles;
 // missing lanes get NaN and never hit.
 template <typename Pack>
@@ -52,7 +57,7 @@ Pack pack_triangle_lanes(std::span<const Triangle> tris) {
     put(p.v0, t.v0);
     put(p.e1, t.e1);
     put(p.e2, t.e2);
-    if constexpr (requires { p.normal; }) put(p.normal, t.normal);
+    if constexpr (StoresNormals<Pack>) put(p.normal, t.normal);
   }
   return p;
 }
@@ -62,7 +67,7 @@ template <typename Pack>
 typename Pack::Kernel::Prepared triangle_lane(const Pack& p, int i) {
   constexpr int W = Pack::kWidth;
   const auto at = [&](const float (&x)[3][W]) { return Vec3f{x[0][i], x[1][i], x[2][i]}; };
-  if constexpr (requires { p.normal; }) return {at(p.v0), at(p.e1), at(p.e2), at(p.normal)};
+  if constexpr (StoresNormals<Pack>) return {at(p.v0), at(p.e1), at(p.e2), at(p.normal)};
   else return {at(p.v0), at(p.e1), at(p.e2)};
 }
 
@@ -121,7 +126,7 @@ RAYBENCH_INLINE int intersect_pack_simd(const Ray& ray, float tmax, const Pack& 
   const std::array<F, 3> d{F::set1(ray.dir.x), F::set1(ray.dir.y), F::set1(ray.dir.z)};
   // Stored, or MollerTrumboreEdges::normal lane by lane.
   const std::array<F, 3> normal = [&] {
-    if constexpr (requires { t.normal; }) {
+    if constexpr (StoresNormals<Pack>) {
       return load3(t.normal);
     } else {
       const std::array<F, 3> e1 = load3(t.e1), e2 = load3(t.e2);
