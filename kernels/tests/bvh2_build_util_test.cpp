@@ -1,5 +1,8 @@
 // Specification of the builders' shared binning (kernels/src/bvh2_build_util.h):
-// a range binned in parallel chunks gets the bins of one pass over it.
+// every reference lands in its centroid_bin on each axis and extends that
+// bin's box as BBox::extend would (NaN coordinates and signed zeros alike),
+// and a range binned in parallel chunks gets the bins of one pass over it.
+// Built twice (CMakeLists.txt): with AVX, and as a machine without it.
 #include "../src/bvh2_build_util.h"
 
 #include <cmath>
@@ -29,11 +32,45 @@ std::vector<Ref> random_refs(std::size_t n, unsigned seed) {
     if (i % 89 == 0) refs[i].bounds.upper = lower;
     if (i % 97 == 0) refs[i].bounds.lower[static_cast<int>(i % 3)] = std::numeric_limits<float>::quiet_NaN();
     if (i >= n / 2 && i < n / 2 + 300) refs[i].bounds = refs[n / 2].bounds;
+    if (i % 7 == 0) refs[i].bounds.lower.y = (i % 14 == 0) ? -0.0f : 0.0f;  // signed zeros, which min and max order
+    if (i % 11 == 0) refs[i].bounds.upper.z = (i % 22 == 0) ? 0.0f : -0.0f;
   }
   return refs;
 }
 
 bool same_float(float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+bool same_bits(float a, float b) { return same_float(a, b) && std::signbit(a) == std::signbit(b); }
+
+TEST(BinAllAxes, PutsEachReferenceInItsCentroidBinAndExtendsTheBinAsBBoxExtend) {
+  constexpr std::size_t kBins = 16;
+  for (const std::size_t n : {std::size_t{1}, std::size_t{37}, std::size_t{5001}}) {
+    for (const int bins : {8, 11, 16}) {
+      SCOPED_TRACE(testing::Message() << n << " references, " << bins << " bins");
+      const std::vector<Ref> refs = random_refs(n, static_cast<unsigned>(n + 7));
+      const float lo[3] = {-10.0f, -9.0f, -11.0f};
+      const float scale[3] = {bins / 20.0f, bins / 19.0f, bins / 21.0f};
+      std::array<std::array<BBox, kBins>, 3> expected_bounds{}, bounds{};
+      std::array<std::array<std::size_t, kBins>, 3> expected_count{}, count{};
+      for (const Ref& r : refs) {
+        const Vec3f c = r.bounds.center();
+        for (int axis = 0; axis < 3; ++axis) {
+          const int b = centroid_bin(c[axis], lo[axis], scale[axis], bins);
+          expected_bounds[axis][b].extend(r.bounds);
+          ++expected_count[axis][b];
+        }
+      }
+      bin_all_axes<kBins>(std::span<const Ref>(refs), lo, scale, bins, bounds, count);
+      for (int axis = 0; axis < 3; ++axis)
+        for (int b = 0; b < bins; ++b) {
+          EXPECT_EQ(count[axis][b], expected_count[axis][b]) << "axis " << axis << " bin " << b;
+          for (int k = 0; k < 3; ++k) {
+            EXPECT_TRUE(same_bits(bounds[axis][b].lower[k], expected_bounds[axis][b].lower[k])) << axis << " " << b;
+            EXPECT_TRUE(same_bits(bounds[axis][b].upper[k], expected_bounds[axis][b].upper[k])) << axis << " " << b;
+          }
+        }
+    }
+  }
+}
 
 TEST(BinAllAxes, InParallelChunksGivesTheBinsOfOnePassForAnyThreadCount) {
   constexpr std::size_t kBins = 16;
