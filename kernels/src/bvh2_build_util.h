@@ -114,13 +114,14 @@ inline BBox bbox_from_lanes(__m128 lower, __m128 upper) {
   return BBox{{l[0], l[1], l[2]}, {u[0], u[1], u[2]}};
 }
 
-// A bin's box while references are binned. With AVX, one vector: the lower
-// corner in the low lanes, the upper corner negated in the high lanes, so
-// one min extends both (max(u, x) is -min(-u, -x), for NaN, which neither
-// takes up, and signed zeros alike): the binning loop's min, max and stores
-// halved, Sibenik's and Conference's builds 10 % faster, the same bins.
-// Without AVX, two SSE vectors.
-struct BinBox {
+// A box being gathered (a bin's, a range's, a range's centroids'), extended
+// as BBox::extend would. With AVX, one vector: the lower corner in the low
+// lanes, the upper corner negated in the high lanes, so one min extends
+// both (max(u, x) is -min(-u, -x), for NaN, which neither takes up, and
+// signed zeros alike): the binning loop's min, max and stores halved,
+// Sibenik's and Conference's builds 10 % faster, the same bins. Without
+// AVX, two SSE vectors.
+struct BoxAccumulator {
 #if defined(__AVX__)
   using Key = __m256;
   __m256 lower_and_negated_upper = _mm256_set1_ps(std::numeric_limits<float>::infinity());
@@ -128,6 +129,7 @@ struct BinBox {
   static Key key(__m128 lower, __m128 upper) { return _mm256_set_m128(_mm_xor_ps(upper, _mm_set1_ps(-0.0f)), lower); }
   // min_ps(x, y) is (x < y ? x : y), as std::min(y, x): BBox::extend's order.
   void extend(Key k) { lower_and_negated_upper = _mm256_min_ps(k, lower_and_negated_upper); }
+  void extend(const BoxAccumulator& b) { extend(b.lower_and_negated_upper); }
   BBox bounds() const {
     return bbox_from_lanes(_mm256_castps256_ps128(lower_and_negated_upper),
                            _mm_xor_ps(_mm256_extractf128_ps(lower_and_negated_upper, 1), _mm_set1_ps(-0.0f)));
@@ -144,6 +146,7 @@ struct BinBox {
     lower = _mm_min_ps(k.lower, lower);
     upper = _mm_max_ps(k.upper, upper);
   }
+  void extend(const BoxAccumulator& b) { extend(Key{b.lower, b.upper}); }
   BBox bounds() const { return bbox_from_lanes(lower, upper); }
 #endif
 };
@@ -155,7 +158,7 @@ struct BinBox {
 // loop: each reference is read once, its centre and its three bins are
 // computed as one SSE vector (the same operations as BBox::center and
 // centroid_bin, so every reference lands in the bin the partition puts it
-// in), its box extends the bins (BinBox: the same comparisons as
+// in), its box extends the bins (BoxAccumulator: the same comparisons as
 // BBox::extend, so NaN boxes bin as before). One set of bins: even and odd
 // references had filled two sets, merged at the end, so that a run of
 // references in one bin would not wait on its own stores; with the fewer
@@ -166,11 +169,11 @@ void bin_all_axes(std::span<const Ref> refs, const float lo[3], const float scal
                   std::array<std::array<BBox, MaxBins>, 3>& bin_bounds,
                   std::array<std::array<std::size_t, MaxBins>, 3>& bin_count) {
 #if defined(__SSE2__)
-  BinBox box[3][MaxBins];
+  BoxAccumulator box[3][MaxBins];
   std::size_t count[3][MaxBins];
   for (int axis = 0; axis < 3; ++axis)
     for (int b = 0; b < bins; ++b) {
-      box[axis][b] = BinBox{};
+      box[axis][b] = BoxAccumulator{};
       count[axis][b] = 0;
     }
   const __m128 lo4 = _mm_setr_ps(lo[0], lo[1], lo[2], 0.0f), scale4 = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
@@ -183,7 +186,7 @@ void bin_all_axes(std::span<const Ref> refs, const float lo[3], const float scal
     const __m128 f = _mm_mul_ps(_mm_sub_ps(centre, lo4), scale4);
     alignas(16) std::int32_t b[4];
     _mm_store_si128(reinterpret_cast<__m128i*>(b), _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(f, zero), last_bin)));
-    const BinBox::Key key = BinBox::key(ref_lower, ref_upper);
+    const BoxAccumulator::Key key = BoxAccumulator::key(ref_lower, ref_upper);
     for (int axis = 0; axis < 3; ++axis) {
       box[axis][b[axis]].extend(key);
       ++count[axis][b[axis]];

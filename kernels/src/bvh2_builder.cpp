@@ -37,29 +37,25 @@ using bvh2_build::centroid_bin;
 using bvh2_build::kMaxBins;
 using bvh2_build::ObjectSplit;
 
-// The box and the centroid box of a range of references, gathered in SSE
+// The box and the centroid box of a range of references, gathered in SIMD
 // registers (the same min/max and centre as BBox::extend and BBox::center).
 struct RangeBounds {
 #if defined(__SSE2__)
-  __m128 lower = _mm_set1_ps(std::numeric_limits<float>::infinity()), upper = _mm_set1_ps(-std::numeric_limits<float>::infinity());
-  __m128 centroid_lower = lower, centroid_upper = upper;
+  bvh2_build::BoxAccumulator box, centroid_box;
 
   void extend(const PrimRef& r) {
+    using Box = bvh2_build::BoxAccumulator;
     const __m128 l = bvh2_build::load_vec3(r.bounds.lower), u = bvh2_build::load_vec3(r.bounds.upper);
     const __m128 c = _mm_mul_ps(_mm_add_ps(l, u), _mm_set1_ps(0.5f));
-    lower = _mm_min_ps(l, lower);
-    upper = _mm_max_ps(u, upper);
-    centroid_lower = _mm_min_ps(c, centroid_lower);
-    centroid_upper = _mm_max_ps(c, centroid_upper);
+    box.extend(Box::key(l, u));
+    centroid_box.extend(Box::key(c, c));
   }
   void extend(const RangeBounds& b) {
-    lower = _mm_min_ps(b.lower, lower);
-    upper = _mm_max_ps(b.upper, upper);
-    centroid_lower = _mm_min_ps(b.centroid_lower, centroid_lower);
-    centroid_upper = _mm_max_ps(b.centroid_upper, centroid_upper);
+    box.extend(b.box);
+    centroid_box.extend(b.centroid_box);
   }
-  BBox bounds() const { return bvh2_build::bbox_from_lanes(lower, upper); }
-  BBox centroids() const { return bvh2_build::bbox_from_lanes(centroid_lower, centroid_upper); }
+  BBox bounds() const { return box.bounds(); }
+  BBox centroids() const { return centroid_box.bounds(); }
 #else
   BBox box, centroid_box;
   void extend(const PrimRef& r) {
