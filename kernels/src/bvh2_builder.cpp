@@ -149,7 +149,7 @@ class Builder {
     };
     // The boxes gather in locals, written out once: gathered in `left` and
     // `right` themselves, they lived in memory, as the swaps' float stores
-    // may alias an SSE vector, and every extend waited on the one before
+    // may alias a SIMD vector, and every extend waited on the one before
     // it through a store and a load (a third of the partition's time).
     RangeBounds l, r;
     for (;;) {

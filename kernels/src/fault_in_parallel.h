@@ -10,6 +10,7 @@
 // thread and on two alike.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <span>
 #include <type_traits>
