@@ -32,7 +32,8 @@ std::vector<Ref> random_refs(std::size_t n, unsigned seed) {
     if (i % 89 == 0) refs[i].bounds.upper = lower;
     if (i % 97 == 0) refs[i].bounds.lower[static_cast<int>(i % 3)] = std::numeric_limits<float>::quiet_NaN();
     if (i >= n / 2 && i < n / 2 + 300) refs[i].bounds = refs[n / 2].bounds;
-    if (i % 7 == 0) refs[i].bounds.lower.y = (i % 14 == 0) ? -0.0f : 0.0f;  // signed zeros, which min and max order
+    // Zeros of both signs, of which min and max keep the one BBox::extend keeps.
+    if (i % 7 == 0) refs[i].bounds.lower.y = (i % 14 == 0) ? -0.0f : 0.0f;
     if (i % 11 == 0) refs[i].bounds.upper.z = (i % 22 == 0) ? 0.0f : -0.0f;
   }
   return refs;
