@@ -17,7 +17,8 @@ machine. When the CSV has each median's min and max over the repetitions, every 
 range too (ours at its slowest / Embree at its fastest, and the reverse), and a ratio below a
 target is said to be within that noise or beyond it; the verdict stays the median's. Build times
 likewise, from their min and max over the timing rounds (a build ratio above 1.0, or a build no
-faster with more threads, is said to be within their range or beyond it).
+faster with more threads, is said to be within their range or beyond it). How noisy the run was
+is said from Embree's own rates: their spread over the repetitions, (max - min) / median, per row.
 Prints Markdown (or writes --out). With --out, a picture of the ratios (PNG beside it, or
 --plot) is drawn and linked from the Markdown. Bad input: one line on stderr, exit 2.
 """
@@ -97,6 +98,28 @@ def scorecard(rows, threads=1):
             "each": {b: r["mrays_s"] / embree["mrays_s"] for b, r in ours.items()},
         })
     return lines
+
+
+# Embree's rates spreading more than this over their repetitions make a row noisy.
+NOISY_SPREAD = 0.10
+
+
+def run_noise(rows, threads=1):
+    """One sentence on how noisy the run was, from Embree's own rows at `threads` (the same code every
+    run, so their spread is the machine's): the median spread over the repetitions, the widest, and
+    how many rows spread more than NOISY_SPREAD. None without the min and max columns."""
+    spreads = sorted(((r["mrays_s_max"] - r["mrays_s_min"]) / r["mrays_s"], r["scene"], r["rayset"], r["backend"])
+                     for r in rows if r["backend"] in ("embree", "embree:high") and r["threads"] == threads
+                     and r["rayset"] in RAYSETS and r["mrays_s"] and r.get("mrays_s_min") is not None
+                     and r.get("mrays_s_max") is not None)
+    if not spreads:
+        return None
+    median = spreads[len(spreads) // 2][0]
+    widest, scene, rayset, backend = spreads[-1]
+    noisy = sum(1 for x in spreads if x[0] > NOISY_SPREAD)
+    return (f"Run noise: Embree's own rates spread over their repetitions by {100 * median:.0f} % (median over its "
+            f"{len(spreads)} rows), at most {100 * widest:.0f} % ({scene} {rayset}, {backend}); {noisy} of "
+            f"{len(spreads)} rows spread more than {100 * NOISY_SPREAD:.0f} %.")
 
 
 def verdict(ok):
@@ -238,6 +261,9 @@ def render(lines, meta, source, rows=(), plot=None):
     if any(x["ratio_range"] for x in lines):
         out += ["", "A ratio's range in brackets: ours at its slowest over the repetitions against Embree at its fastest, "
                 "and the reverse; for build times, our fastest build against Embree's slowest, and the reverse."]
+    noise = run_noise(rows)
+    if noise:
+        out += ["", noise]
     ratios = [x["ratio"] for x in lines]
     per_rayset = {rs: geometric_mean([x["ratio"] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
     overall = geometric_mean(ratios)

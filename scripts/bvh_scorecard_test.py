@@ -94,6 +94,21 @@ class Scorecard(unittest.TestCase):
                       "1 of them within their min–max | **missed** |", out)
         self.assertIn("A ratio's range in brackets", out)
 
+    def test_says_how_noisy_the_run_was_from_embrees_own_spread_over_the_repetitions(self):
+        rows = []
+        for scene, wide in (("a", False), ("b", False), ("c", True)):
+            for rayset in ("primary", "diffuse", "shadow"):
+                spread_hi = 13.0 if wide and rayset == "diffuse" else 10.2
+                rows += [spread(row(scene, rayset, "embree", 10.0), 9.9, spread_hi),
+                         spread(row(scene, rayset, "bvh8", 11.0), 10.9, 11.1),
+                         spread(row(scene, rayset, "embree", 18.0, threads=2), 1.0, 30.0)]  # another thread count
+        result = self.run_on(rows)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertIn("Run noise: Embree's own rates spread over their repetitions by 3 % (median over its 9 rows), "
+                      "at most 31 % (c diffuse, embree); 1 of 9 rows spread more than 10 %.", result.stdout)
+        without = self.run_on([row("a", "primary", "embree", 10.0), row("a", "primary", "bvh8", 11.0)])
+        self.assertNotIn("Run noise", without.stdout, "no sentence without the min and max columns")
+
     def test_build_times_get_their_range_and_a_slower_build_says_whether_noise_covers_it(self):
         rows = []
         for scene, (ours, lo, hi) in {"a": (110, 90, 130), "b": (120, 115, 125), "c": (80, 75, 85)}.items():
