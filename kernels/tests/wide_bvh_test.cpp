@@ -338,6 +338,45 @@ TEST_P(WideBvhBuild, TheTreeIsTheSameBuiltOnOneThreadOrTwo) {
   });
 }
 
+// The collapse faults the pages of its output in on every thread before
+// filling them (kernels/src/fault_in_parallel.h); with arrays of several
+// huge pages that runs, and the tree must still be the same as on one
+// thread, every leaf form filled whole.
+TEST(WideBvhCollapse, ATreeSpanningSeveralHugePagesIsTheSameBuiltOnOneThreadOrTwo) {
+  const auto tris = random_soup(80000, 5);
+  Bvh2BuildOptions options;  // the default build's, as bvh8 makes it
+  options.leaf_granularity = 8;
+  options.max_leaf_size = 8;
+  const Bvh2 bvh2 = build_bvh2(tris, Bvh2Builder::kBinnedSah, options);
+  for (const WideLeaves leaves : {WideLeaves::kMollerTrumbore, WideLeaves::kMollerTrumboreEdges, WideLeaves::kVertices}) {
+    WideBvh<8> one, two;
+    tbb::task_arena(1).execute([&] { one = collapse_bvh2<8>(bvh2, tris, leaves, WideLaneOrder::kByArea); });
+    tbb::task_arena(2).execute([&] { two = collapse_bvh2<8>(bvh2, tris, leaves, WideLaneOrder::kByArea); });
+    const auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
+    ASSERT_GT(bytes(one.packs) + bytes(one.edge_packs) + bytes(one.vertex_packs), kHugePageBytes);  // two or more
+    ASSERT_EQ(one.nodes.size(), two.nodes.size());
+    EXPECT_EQ(0, std::memcmp(one.nodes.data(), two.nodes.data(), bytes(one.nodes)));
+    EXPECT_TRUE(one.pack_prims == two.pack_prims);
+    ASSERT_EQ(one.packs.size(), two.packs.size());
+    ASSERT_EQ(one.edge_packs.size(), two.edge_packs.size());
+    ASSERT_EQ(one.vertex_packs.size(), two.vertex_packs.size());
+    EXPECT_EQ(0, std::memcmp(one.packs.data(), two.packs.data(), bytes(one.packs)));
+    EXPECT_EQ(0, std::memcmp(one.edge_packs.data(), two.edge_packs.data(), bytes(one.edge_packs)));
+    EXPECT_EQ(0, std::memcmp(one.vertex_packs.data(), two.vertex_packs.data(), bytes(one.vertex_packs)));
+    // Filled whole: every used lane holds its triangle (a lane left as the
+    // fault's zero bytes would hold the triangle (0,0,0)-(0,0,0)-(0,0,0)).
+    for (std::size_t p = 0; p < one.pack_prims.size() / 8; ++p)
+      for (int lane = 0; lane < 8; ++lane) {
+        const std::int32_t prim = one.pack_prims[p * 8 + lane];
+        if (prim < 0) continue;
+        if (leaves == WideLeaves::kVertices) {
+          const Triangle t = one.vertex_packs[p].lane(lane);
+          ASSERT_EQ(0, std::memcmp(&t, &tris[prim], sizeof(Triangle))) << "pack " << p << " lane " << lane;
+        }
+      }
+  }
+}
+
 TEST_P(WideBvhBuild, EmptyInputBuildsATreeThatNothingHits) {
   const std::vector<Triangle> none;
   for_each_width([&](auto width) {
