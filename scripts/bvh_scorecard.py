@@ -24,6 +24,7 @@ Prints Markdown (or writes --out). With --out, a picture of the ratios (PNG besi
 """
 import argparse
 import os
+import statistics
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -114,7 +115,7 @@ def run_noise(rows, threads=1):
                      and r.get("mrays_s_max") is not None)
     if not spreads:
         return None
-    median = spreads[len(spreads) // 2][0]
+    median = statistics.median(x[0] for x in spreads)
     widest, scene, rayset, backend = spreads[-1]
     noisy = sum(1 for x in spreads if x[0] > NOISY_SPREAD)
     return (f"Run noise: Embree's own rates spread over their repetitions by {100 * median:.0f} % (median over its "
