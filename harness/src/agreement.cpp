@@ -5,6 +5,8 @@
 #include <limits>
 #include <vector>
 
+#include "referee/exact_triangle.h"
+
 namespace raybench {
 
 double nearest_rank_percentile(std::vector<double>& values, double p) {
@@ -14,7 +16,9 @@ double nearest_rank_percentile(std::vector<double>& values, double p) {
   return values[rank];
 }
 
-Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference) {
+Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference, std::span<const Ray> rays,
+                       std::span<const Triangle> triangles) {
+  const bool exact_ties = !rays.empty() && !triangles.empty();
   Agreement a;
   a.has_prims = true;
   a.rays = tested.size();
@@ -28,7 +32,9 @@ Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> referen
     if (!t.hit()) continue;
     ++a.both_hit;
     if (t.prim == r.prim) ++a.same_prim;
-    else if (t.t == r.t) ++a.prim_ties;
+    else if (t.t == r.t || (exact_ties && same_exact_t(rays[i], triangles[static_cast<std::size_t>(t.prim)],
+                                                       triangles[static_cast<std::size_t>(r.prim)])))
+      ++a.prim_ties;
     const double diff = std::fabs(static_cast<double>(t.t) - r.t);
     relerr.push_back(r.t != 0.0f ? diff / std::fabs(static_cast<double>(r.t)) : diff);
   }

@@ -232,7 +232,7 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
           if (query_of(rs.kind) == Query::kIntersect) {
             std::vector<Hit> hits(rs.rays.size());
             executor.intersect(*backend, rs.rays, hits);
-            a = compare_hits(hits, ref_hits[r]);
+            a = compare_hits(hits, ref_hits[r], rs.rays, scene.triangles);
             if (accuracy) judge_hits(*referee, rs.rays, rs.truth, hits, rs.sources, *accuracy);
           } else {
             std::vector<std::uint8_t> occ(rs.rays.size());

@@ -29,6 +29,26 @@ TEST(Agreement, CountsHitMissPrimAndTiesPerRay) {
   EXPECT_DOUBLE_EQ(a.t_relerr_p999, 0.1);
 }
 
+TEST(Agreement, GivenTheGeometryCoincidentTrianglesAtDifferentFloatDistancesTie) {
+  // Triangles 0 and 1 lie in the plane z = 0 (1 a copy of 0), triangle 2
+  // in z = -1. Both tracers hit the plane at t = 1, but round it apart.
+  const std::vector<Triangle> triangles{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
+                                        {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
+                                        {{0, 0, -1}, {1, 0, -1}, {0, 1, -1}}};
+  const std::vector<Ray> rays(2, Ray{{0.25f, 0.25f, 1}, 0, {0, 0, -1}});
+  const std::vector<Hit> reference{{1.0f, 0, 0, 0}, {1.0f, 0, 0, 0}};
+  const std::vector<Hit> tested{{0x1.000002p+0f, 1, 0, 0},  // the copy, one ulp off: a tie
+                                {2.0f, 2, 0, 0}};           // the plane behind: an error
+  const Agreement with_geometry = compare_hits(tested, reference, rays, triangles);
+  EXPECT_EQ(with_geometry.prim_ties, 1u);
+  EXPECT_EQ(with_geometry.same_prim, 0u);
+  // Without it, only equal floats tie.
+  EXPECT_EQ(compare_hits(tested, reference).prim_ties, 0u);
+  // A ray in the planes' direction crosses neither once: no tie, whatever the floats.
+  const std::vector<Ray> grazing(2, Ray{{0.25f, 0.25f, 0}, 0, {1, 0, 0}});
+  EXPECT_EQ(compare_hits(tested, reference, grazing, triangles).prim_ties, 0u);
+}
+
 TEST(Agreement, PercentileIgnoresTheRareOutlier) {
   std::vector<Hit> reference(2000, Hit{1.0f, 0, 0, 0}), tested = reference;
   tested[5].t = 2.0f;  // one ray in 2000: above the 99.9th percentile

@@ -155,4 +155,10 @@ int compare_exact_t(const Ray& ray, const Triangle& a, const Triangle& b) {
   return CGAL::compare(ka.num / ka.den, kb.num / kb.den);
 }
 
+bool same_exact_t(const Ray& ray, const Triangle& a, const Triangle& b) {
+  const Terms<Rational> ka = terms<Rational>(ray, a), kb = terms<Rational>(ray, b);
+  if (CGAL::is_zero(ka.den) || CGAL::is_zero(kb.den)) return false;
+  return ka.num * kb.den == kb.num * ka.den;  // num_a / den_a == num_b / den_b, without dividing
+}
+
 }  // namespace raybench

@@ -53,4 +53,10 @@ ExactTriangleHit exact_intersect(const Ray& ray, const Triangle& triangle, TValu
 // planes of two triangles, each crossed once (den != 0): -1, 0 or +1.
 int compare_exact_t(const Ray& ray, const Triangle& a, const Triangle& b);
 
+// Whether the ray's line crosses the planes of both triangles once and at
+// exactly the same t (coincident or coplanar geometry): two tracers that
+// report these two triangles have both found the nearest distance, each
+// rounding its own way.
+bool same_exact_t(const Ray& ray, const Triangle& a, const Triangle& b);
+
 }  // namespace raybench
