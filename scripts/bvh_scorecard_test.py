@@ -76,7 +76,23 @@ class Scorecard(unittest.TestCase):
         self.assertIn("| our best ≥ 1.0 × Embree's best on every scene and ray set | min 0.90; 1 of 1 rows below 1.0 | "
                       "**missed** |", out)
         # 0.99 same triangle plus 5 ties among 500 rays both hit: 100 %.
-        self.assertIn("| same triangle ≥ 99.9 % (ties agree) | min 100.00 % | **met** |", out)
+        self.assertIn("| same triangle ≥ 99.9 % (ties agree), every backend of ours | min 100.00 % (bvh2, a primary) | "
+                      "**met** |", out)
+
+    def test_agreement_targets_hold_every_backend_of_ours_not_only_the_fastest(self):
+        slow_and_wrong = row("a", "shadow", "bvh8:watertight:robust", 8.0)
+        slow_and_wrong["agree_hit"] = 0.9919
+        rows = [row("a", "shadow", "embree", 10.0), row("a", "shadow", "bvh8", 11.0), slow_and_wrong,
+                row("a", "diffuse", "embree", 10.0), row("a", "diffuse", "bvh8", 11.0),
+                row("a", "diffuse", "bvh8:watertight:robust", 8.0, agree_prim="0.99")]
+        out = self.run_on(rows, "--no-plot").stdout
+        # The table's columns are our best's (bvh8, in full agreement) ...
+        self.assertIn("| a | shadow | embree | 10.00 | bvh8 | 11.00 | 1.10 |", out)
+        # ... the targets every backend's: 99 % same triangle, no ties, among 500 rays both hit.
+        self.assertIn("| hit/miss agreement ≥ 99.99 %, every backend of ours | min 99.190 % "
+                      "(bvh8:watertight:robust, a shadow) | **missed** |", out)
+        self.assertIn("| same triangle ≥ 99.9 % (ties agree), every backend of ours | min 99.00 % "
+                      "(bvh8:watertight:robust, a diffuse) | **missed** |", out)
 
     def test_each_ratio_gets_its_range_over_the_repetitions_and_a_miss_says_whether_noise_covers_it(self):
         rows = [spread(row("a", "diffuse", "embree", 10.0), 9.0, 10.5),
