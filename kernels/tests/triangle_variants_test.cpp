@@ -167,54 +167,6 @@ TEST(Watertight, ATriangleWithTwoEqualVerticesMissesRaysThroughItsSegmentAndEnds
       }
 }
 
-// Conference's floor (triangle 60 of conference.ply, 2,600 units across),
-// and a diffuse ray of the default suite leaving it from an origin offset
-// 3.1e-5 above it, upward (bit for bit).
-const Triangle kConferenceFloor{{-0x1.d971aap+9f, -0x1.927914p+0f, 0x1.4e3e98p+9f},
-                                {0x1.9d5p+10f, -0x1.927914p+0f, 0x1.4e3e98p+9f},
-                                {0x1.9d5p+10f, -0x1.927914p+0f, -0x1.fc0cccp+9f}};
-const Ray kLeavingTheFloor = ray({0x1.325598p+10f, -0x1.927714p+0f, -0x1.864acap+7f},
-                                 {-0x1.a5b518p-4f, 0x1.648a0cp-1f, -0x1.6ba7b6p-1f});
-
-TEST(Watertight, ARayLeavingALargeTriangleDoesNotHitItAgain) {
-  // The exact distance to the floor is -4.4e-5 (behind the origin); t
-  // interpolated from the vertices' depths, which reach 860 units, came out
-  // +1.5e-5 before the near end was made conservative (pbrt-v4's bound).
-  EXPECT_FALSE(hits<WatertightTriangle>(kLeavingTheFloor, kConferenceFloor));
-  // The same ray moved down below the floor hits it, at the distance.
-  TriangleHit h;
-  const Vec3f below = kLeavingTheFloor.org - kLeavingTheFloor.dir * 0.01f;
-  ASSERT_TRUE(hits<WatertightTriangle>(ray(below, kLeavingTheFloor.dir), kConferenceFloor, &h));
-  EXPECT_NEAR(h.t, 0.01f, 1e-3f);
-}
-
-TEST(Watertight, AHitCloserThanItsErrorBoundIsNotReported) {
-  // The price of the bound: it grows with the triangle's extent along the
-  // ray's dominant axis (for the floor and this slanted ray, about 1e-3
-  // units), and a true hit closer than that is dropped rather than risked
-  // behind the origin. Farther, the hit is kept; straight down, the floor
-  // has no depth along the ray and even a close hit is kept.
-  const Vec3f slanted_down{kLeavingTheFloor.dir.x, -kLeavingTheFloor.dir.y, kLeavingTheFloor.dir.z};
-  const Vec3f above = kLeavingTheFloor.org + Vec3f{0, 1e-4f, 0};
-  EXPECT_FALSE(hits<WatertightTriangle>(ray(above, slanted_down), kConferenceFloor));
-  EXPECT_TRUE(hits<WatertightTriangle>(ray(kLeavingTheFloor.org + Vec3f{0, 0.02f, 0}, slanted_down), kConferenceFloor));
-  EXPECT_TRUE(hits<WatertightTriangle>(ray(above, {0, -1, 0}), kConferenceFloor));
-}
-
-TEST(Watertight, TheDirectionsLengthChangesNoAnswer) {
-  // Edge- and vertex-aimed rays (target - origin) can be short or long; the
-  // error bound is in units of t and scales with them (pbrt's form, which
-  // adds the scaled depth to the sheared x and y errors, rejected every hit
-  // of a direction 1e-6 long).
-  for (float length : {1e-6f, 1e-3f, 1.0f, 1e3f, 1e6f}) {
-    TriangleHit h;
-    ASSERT_TRUE(hits<WatertightTriangle>(ray({0.25f, 0.25f, 1}, {0, 0, -length}), kUnit, &h)) << length;
-    EXPECT_NEAR(h.t * length, 1.0f, 1e-6f) << length;
-    const Vec3f slanted = normalize(Vec3f{0.1f, 0.2f, -1}) * length;
-    ASSERT_TRUE(hits<WatertightTriangle>(ray(Vec3f{0.25f, 0.25f, 0} - slanted * (1.0f / length), slanted), kUnit)) << length;
-  }
-}
-
 TEST(MollerTrumbore, KnownFailure_LeaksThroughSharedEdgesOfAClosedMesh) {
   // EXTREMES.md: 11 % of edge-aimed and 10 % of vertex-aimed rays miss.
   // Not watertight: the float edge tests of neighbours do not agree.

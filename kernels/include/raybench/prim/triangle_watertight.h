@@ -18,22 +18,6 @@
 // scaled t as well (an early reject for scalar code; the 8-wide test divides
 // every lane anyway).
 // Not culled: both faces hit. Degenerate triangles (U+V+W == 0) miss.
-//
-// The distance is conservative at the near end, as in pbrt-v4
-// (Triangle::Intersect, "ensure that computed triangle t is conservatively
-// greater than zero"; Pharr, Jakob & Humphreys, Physically Based Rendering,
-// 4th ed.): T is interpolated from the vertices' scaled z, so its
-// error scales with the triangle's extent along the ray, not with t. A ray
-// leaving a large triangle (Conference's floor, 2,600 units across, from an
-// origin offset 3e-5 above it) computed t = +1.5e-5 where the exact t is
-// -4.4e-5, and hit the triangle it leaves: 0.8 % of Conference's diffuse and
-// shadow rays through bvh8:watertight:robust. A hit is reported only when
-// t - delta_t > tnear, delta_t being pbrt's bound on |t - exact t| (which
-// covers this test's fused shear and fused T, each one rounding fewer),
-// corrected for directions not of unit length (t_error_bound).
-// Its two equal terms gamma(3) max|z| max|e| and delta_z max|e| are summed
-// as one, and max|e| and delta_e are divided by |det| first, so that the
-// bound does not overflow before the division for large coordinates.
 #pragma once
 
 #include <cmath>
@@ -121,34 +105,7 @@ struct WatertightTriangle {
     const float t_scaled = std::fma(u, az, std::fma(v, bz, w * cz));
     const float inv_det = 1.0f / det;
     out = {t_scaled * inv_det, v * inv_det, w * inv_det};
-    // max as the 8-wide test's _mm256_max_ps (the second operand when either is NaN).
-    const auto max2 = [](float p, float q) { return p > q ? p : q; };
-    const auto max_abs = [&](float p, float q, float s) { return max2(max2(std::fabs(p), std::fabs(q)), std::fabs(s)); };
-    const float delta_t = t_error_bound(max_abs(ax, bx, cx), max_abs(ay, by, cy), max_abs(a[r.kz], b[r.kz], c[r.kz]),
-                                        max_abs(az, bz, cz), max_abs(u, v, w), std::fabs(inv_det));
-    return out.t - delta_t > r.tnear && out.t <= tmax;
-  }
-
-  // gamma(n) = n u / (1 - n u), u = 2^-24 (pbrt-v4's gamma), as floats.
-  static constexpr float gamma(int n) {
-    constexpr double u = 0x1p-24;
-    return static_cast<float>(n * u / (1.0 - n * u));
-  }
-  // pbrt-v4's bound on the error of t, from the triangle's largest sheared
-  // |x| and |y|, its largest |z| before and after the scaling by Sz, its
-  // largest |u|, |v|, |w| and 1 / |det|. The sheared x = x - Sx z carries
-  // the error of z (|Sx| <= 1), not of Sz z: pbrt adds the scaled z there,
-  // the same for a unit direction but 1e6 times too much for a direction
-  // of length 1e-6 (an edge-aimed ray, target - origin, in a sphere of
-  // radius 1e-6: every one rejected). The 8-wide test
-  // (simd/triangle8_watertight.h) computes it with the same operations in
-  // the same order.
-  static float t_error_bound(float max_x, float max_y, float max_z, float max_scaled_z, float max_e, float abs_inv_det) {
-    const float delta_z = gamma(3) * max_scaled_z;
-    const float delta_x = gamma(5) * (max_x + max_z);
-    const float delta_y = gamma(5) * (max_y + max_z);
-    const float delta_e = 2.0f * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-    return 3.0f * (2.0f * (delta_z * (max_e * abs_inv_det)) + (delta_e * abs_inv_det) * max_scaled_z);
+    return out.t > r.tnear && out.t <= tmax;
   }
   static bool intersect(const Ray& ray, float tmax, const Triangle& tri, TriangleHit& out) {
     return intersect(precompute(ray), tmax, tri, out);

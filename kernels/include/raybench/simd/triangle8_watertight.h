@@ -68,82 +68,33 @@ inline int intersect8_watertight_scalar(const WatertightTriangle::RayData& ray, 
 }
 
 #if defined(__AVX2__)
-// The pack's vertices relative to the ray's origin in its sheared frame:
-// (x, y) and the kz component z, vertex by vertex, and the scaled
-// barycentrics u, v, w (the 2x2 determinants), as the scalar test computes
-// them, lane by lane.
-struct ShearedPack8 {
-  __m256 x[3], y[3], z[3];
-  __m256 u, v, w;
-
-  RAYBENCH_INLINE static ShearedPack8 of(const WatertightTriangle::RayData& r, const TriangleVertices8& t) {
-    // Axis kx of vertex k lies at px + kVertex * k: one base per axis and
-    // constant offsets. Indexed as t.v[k][r.kx], the compiler kept nine
-    // offsets, spilled them, and reloaded each before its vertex load; with
-    // the bases, measured 4-10 % more shadow rays per second through
-    // bvh8:watertight:robust (bunny, Sibenik, Lucy, Sponza-Dabrovic, engine;
-    // one thread), primary and diffuse rays within noise. The gain is
-    // fragile: the same bases taken from reinterpret_cast<const float*>(&t)
-    // compiled differently and measured no faster than indexing.
-    constexpr int kVertex = 3 * 8;  // floats from one vertex's axis to the next vertex's
-    static_assert(sizeof(TriangleVertices8::v[0]) == kVertex * sizeof(float));
-    const float* px = t.v[0][r.kx];
-    const float* py = t.v[0][r.ky];
-    const float* pz = t.v[0][r.kz];
-    const __m256 sx = _mm256_set1_ps(r.sx), sy = _mm256_set1_ps(r.sy);
-    const __m256 ox = _mm256_set1_ps(r.ox), oy = _mm256_set1_ps(r.oy), oz = _mm256_set1_ps(r.oz);
-    ShearedPack8 p;
-    for (int k = 0; k < 3; ++k) {
-      p.z[k] = _mm256_sub_ps(_mm256_load_ps(pz + kVertex * k), oz);
-      p.x[k] = _mm256_fnmadd_ps(sx, p.z[k], _mm256_sub_ps(_mm256_load_ps(px + kVertex * k), ox));
-      p.y[k] = _mm256_fnmadd_ps(sy, p.z[k], _mm256_sub_ps(_mm256_load_ps(py + kVertex * k), oy));
-    }
-    p.u = _mm256_sub_ps(_mm256_mul_ps(p.x[2], p.y[1]), _mm256_mul_ps(p.y[2], p.x[1]));
-    p.v = _mm256_sub_ps(_mm256_mul_ps(p.x[0], p.y[2]), _mm256_mul_ps(p.y[0], p.x[2]));
-    p.w = _mm256_sub_ps(_mm256_mul_ps(p.x[1], p.y[0]), _mm256_mul_ps(p.y[1], p.x[0]));
-    return p;
-  }
-};
-
-// Of `lanes`, those whose distance tt clears tnear by the scalar test's
-// error bound (t - delta_t > tnear, WatertightTriangle::t_error_bound), with
-// the same operations in the same order. Out of line, on the lanes that hit
-// only: it recomputes the sheared vertices rather than keep them alive
-// through the division; inlined, with them kept, the bound cost
-// bvh8:watertight:robust 7 % (every ray kind, six scenes, interleaved), and
-// checking the closest lane with the inlined scalar test 16 %.
-[[gnu::noinline]] inline int lanes_past_error_bound(const WatertightTriangle::RayData& r, const TriangleVertices8& t,
-                                                    __m256 tt, __m256 inv_det, int lanes) {
-  const ShearedPack8 p = ShearedPack8::of(r, t);
-  const __m256 sz = _mm256_set1_ps(r.sz), sign = _mm256_set1_ps(-0.0f);
-  const auto max_abs = [&](__m256 a, __m256 b, __m256 c) {
-    return _mm256_max_ps(_mm256_max_ps(_mm256_andnot_ps(sign, a), _mm256_andnot_ps(sign, b)), _mm256_andnot_ps(sign, c));
-  };
-  const __m256 max_x = max_abs(p.x[0], p.x[1], p.x[2]), max_y = max_abs(p.y[0], p.y[1], p.y[2]);
-  const __m256 max_z = max_abs(p.z[0], p.z[1], p.z[2]);
-  const __m256 max_scaled_z = max_abs(_mm256_mul_ps(sz, p.z[0]), _mm256_mul_ps(sz, p.z[1]), _mm256_mul_ps(sz, p.z[2]));
-  const __m256 max_e = max_abs(p.u, p.v, p.w), abs_inv_det = _mm256_andnot_ps(sign, inv_det);
-  const auto gamma = [](int n) { return _mm256_set1_ps(WatertightTriangle::gamma(n)); };
-  const __m256 delta_z = _mm256_mul_ps(gamma(3), max_scaled_z);
-  const __m256 delta_x = _mm256_mul_ps(gamma(5), _mm256_add_ps(max_x, max_z));
-  const __m256 delta_y = _mm256_mul_ps(gamma(5), _mm256_add_ps(max_y, max_z));
-  const __m256 delta_e = _mm256_mul_ps(
-      _mm256_set1_ps(2.0f),
-      _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(gamma(2), max_x), max_y), _mm256_mul_ps(delta_y, max_x)),
-                    _mm256_mul_ps(delta_x, max_y)));
-  const __m256 delta_t = _mm256_mul_ps(
-      _mm256_set1_ps(3.0f),
-      _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(2.0f), _mm256_mul_ps(delta_z, _mm256_mul_ps(max_e, abs_inv_det))),
-                    _mm256_mul_ps(_mm256_mul_ps(delta_e, abs_inv_det), max_scaled_z)));
-  return lanes & _mm256_movemask_ps(_mm256_cmp_ps(_mm256_sub_ps(tt, delta_t), _mm256_set1_ps(r.tnear), _CMP_GT_OQ));
-}
-
 RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData& r, float tmax, const TriangleVertices8& t,
                                       TriangleHit& out) {
-  const ShearedPack8 p = ShearedPack8::of(r, t);
-  const __m256 (&z)[3] = p.z;
-  const __m256 u = p.u, v = p.v, w = p.w;
-  const __m256 sz = _mm256_set1_ps(r.sz);
+  // Axis kx of vertex k lies at px + kVertex * k: one base per axis and
+  // constant offsets. Indexed as t.v[k][r.kx], the compiler kept nine
+  // offsets, spilled them, and reloaded each before its vertex load; with the
+  // bases, measured 4-10 % more shadow rays per second through
+  // bvh8:watertight:robust (bunny, Sibenik, Lucy, Sponza-Dabrovic, engine;
+  // one thread), primary and diffuse rays within noise. The gain is fragile:
+  // the same bases taken from reinterpret_cast<const float*>(&t) compiled
+  // differently and measured no faster than indexing.
+  constexpr int kVertex = 3 * 8;  // floats from one vertex's axis to the next vertex's
+  static_assert(sizeof(TriangleVertices8::v[0]) == kVertex * sizeof(float));
+  const float* px = t.v[0][r.kx];
+  const float* py = t.v[0][r.ky];
+  const float* pz = t.v[0][r.kz];
+  const __m256 sx = _mm256_set1_ps(r.sx), sy = _mm256_set1_ps(r.sy), sz = _mm256_set1_ps(r.sz);
+  const __m256 ox = _mm256_set1_ps(r.ox), oy = _mm256_set1_ps(r.oy), oz = _mm256_set1_ps(r.oz);
+  // Vertex k relative to the origin, sheared: (x, y) in the ray's frame and its kz component.
+  __m256 x[3], y[3], z[3];
+  for (int k = 0; k < 3; ++k) {
+    z[k] = _mm256_sub_ps(_mm256_load_ps(pz + kVertex * k), oz);
+    x[k] = _mm256_fnmadd_ps(sx, z[k], _mm256_sub_ps(_mm256_load_ps(px + kVertex * k), ox));
+    y[k] = _mm256_fnmadd_ps(sy, z[k], _mm256_sub_ps(_mm256_load_ps(py + kVertex * k), oy));
+  }
+  const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
+  const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
+  const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
   const __m256 zero = _mm256_setzero_ps();
   // Outside: the smallest determinant negative and the largest positive.
   // Strictly inside: all three of one sign, none zero. min/max return one
@@ -180,7 +131,6 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
                                                         _mm256_cmp_ps(tt, _mm256_set1_ps(tmax), _CMP_LE_OQ)));
   int mask = _mm256_movemask_ps(ok);
   if (!mask && !exact) return -1;
-  if (mask) mask = lanes_past_error_bound(r, t, tt, inv_det, mask);
   alignas(32) float ts[8], us[8], vs[8];
   _mm256_store_ps(ts, tt);
   _mm256_store_ps(us, _mm256_mul_ps(v, inv_det));
