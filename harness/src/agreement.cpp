@@ -19,6 +19,8 @@ double nearest_rank_percentile(std::vector<double>& values, double p) {
 Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference, std::span<const Ray> rays,
                        std::span<const Triangle> triangles) {
   const bool exact_ties = !rays.empty() && !triangles.empty();
+  // A prim outside the scene (a backend's bug) is never a tie, and never indexes past it.
+  const auto in_scene = [&](std::int32_t prim) { return prim >= 0 && static_cast<std::size_t>(prim) < triangles.size(); };
   Agreement a;
   a.has_prims = true;
   a.rays = tested.size();
@@ -32,8 +34,9 @@ Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> referen
     if (!t.hit()) continue;
     ++a.both_hit;
     if (t.prim == r.prim) ++a.same_prim;
-    else if (t.t == r.t || (exact_ties && same_exact_t(rays[i], triangles[static_cast<std::size_t>(t.prim)],
-                                                       triangles[static_cast<std::size_t>(r.prim)])))
+    else if (t.t == r.t || (exact_ties && in_scene(t.prim) && in_scene(r.prim) &&
+                            same_exact_t(rays[i], triangles[static_cast<std::size_t>(t.prim)],
+                                         triangles[static_cast<std::size_t>(r.prim)])))
       ++a.prim_ties;
     const double diff = std::fabs(static_cast<double>(t.t) - r.t);
     relerr.push_back(r.t != 0.0f ? diff / std::fabs(static_cast<double>(r.t)) : diff);

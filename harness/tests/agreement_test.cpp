@@ -47,6 +47,9 @@ TEST(Agreement, GivenTheGeometryCoincidentTrianglesAtDifferentFloatDistancesTie)
   // A ray in the planes' direction crosses neither once: no tie, whatever the floats.
   const std::vector<Ray> grazing(2, Ray{{0.25f, 0.25f, 0}, 0, {1, 0, 0}});
   EXPECT_EQ(compare_hits(tested, reference, grazing, triangles).prim_ties, 0u);
+  // A triangle index outside the scene (a backend's bug) is no tie, and no crash.
+  const std::vector<Hit> out_of_scene{{0x1.000002p+0f, 3, 0, 0}, {2.0f, 2, 0, 0}};
+  EXPECT_EQ(compare_hits(out_of_scene, reference, rays, triangles).prim_ties, 0u);
 }
 
 TEST(Agreement, PercentileIgnoresTheRareOutlier) {
