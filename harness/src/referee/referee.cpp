@@ -112,8 +112,8 @@ bool Referee::accepts(const Ray& ray, const RefereeVerdict& verdict, std::int32_
   if (prim == verdict.prim) return true;
   if (!verdict.tie) return false;
   const Triangle& tri = scene_.triangles[prim];
-  // Only hit or miss is needed here, and compare_exact_t decides t exactly.
-  return exact_intersect(ray, tri, TValue::kEnclosed).hit && compare_exact_t(ray, tri, scene_.triangles[verdict.prim]) == 0;
+  // Only hit or miss is needed here, and same_exact_t decides t exactly.
+  return exact_intersect(ray, tri, TValue::kEnclosed).hit && same_exact_t(ray, tri, scene_.triangles[verdict.prim]);
 }
 
 }  // namespace raybench
