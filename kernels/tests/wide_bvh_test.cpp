@@ -363,15 +363,24 @@ TEST(WideBvhCollapse, ATreeSpanningSeveralHugePagesIsTheSameBuiltOnOneThreadOrTw
     EXPECT_EQ(0, std::memcmp(one.packs.data(), two.packs.data(), bytes(one.packs)));
     EXPECT_EQ(0, std::memcmp(one.edge_packs.data(), two.edge_packs.data(), bytes(one.edge_packs)));
     EXPECT_EQ(0, std::memcmp(one.vertex_packs.data(), two.vertex_packs.data(), bytes(one.vertex_packs)));
-    // Filled whole: every used lane holds its triangle (a lane left as the
-    // fault's zero bytes would hold the triangle (0,0,0)-(0,0,0)-(0,0,0)).
+    // Filled whole: every used lane holds its triangle, as its leaf form
+    // stores it (a lane left as the fault's zero bytes would hold zeros).
+    const auto expect_lane = [&](const auto& pack, const auto& expected, std::size_t p, int lane) {
+      const auto stored = pack.lane(lane);
+      static_assert(sizeof(stored) == sizeof(expected));
+      ASSERT_EQ(0, std::memcmp(&stored, &expected, sizeof(stored))) << "pack " << p << " lane " << lane;
+    };
     for (std::size_t p = 0; p < one.pack_prims.size() / 8; ++p)
       for (int lane = 0; lane < 8; ++lane) {
         const std::int32_t prim = one.pack_prims[p * 8 + lane];
         if (prim < 0) continue;
-        if (leaves == WideLeaves::kVertices) {
-          const Triangle t = one.vertex_packs[p].lane(lane);
-          ASSERT_EQ(0, std::memcmp(&t, &tris[prim], sizeof(Triangle))) << "pack " << p << " lane " << lane;
+        const Triangle& tri = tris[static_cast<std::size_t>(prim)];
+        switch (leaves) {
+          case WideLeaves::kMollerTrumbore: expect_lane(one.packs[p], Triangle8::Kernel::prepare(tri), p, lane); break;
+          case WideLeaves::kMollerTrumboreEdges:
+            expect_lane(one.edge_packs[p], TriangleEdgePack<8>::Kernel::prepare(tri), p, lane);
+            break;
+          case WideLeaves::kVertices: expect_lane(one.vertex_packs[p], tri, p, lane); break;
         }
       }
   }
