@@ -381,9 +381,6 @@ class Collapser {
     }
     for (std::uint32_t k = 0; k < W; ++k)
       out_.pack_prims[i * W + k] = k < count ? static_cast<std::int32_t>(ids[k]) : -1;
-    if constexpr (W == 8)
-      if (leaves_ == WideLeaves::kVertices)  // the pack's own copy, for the traversal (triangle8_watertight.h)
-        for (std::uint32_t k = 0; k < W; ++k) out_.vertex_packs[i].prim[k] = out_.pack_prims[i * W + k];
   }
 
   const Bvh2& bvh2_;

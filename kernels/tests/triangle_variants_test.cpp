@@ -167,27 +167,39 @@ TEST(Watertight, ATriangleWithTwoEqualVerticesMissesRaysThroughItsSegmentAndEnds
       }
 }
 
-TEST(Watertight, KnownFailure_ARayLeavingALargeTriangleHitsItAgain) {
+TEST(Watertight, ARayLeavingALargeTriangleDoesNotHitItAgain) {
   // Conference's floor (triangle 60 of conference.ply, 2,600 units across)
   // and a diffuse ray of the default suite leaving it upward from an origin
   // offset 3.1e-5 above it (bit for bit). The exact distance is -4.4e-5,
-  // behind the origin; t, interpolated from the vertices' depths along the
-  // ray (up to 860 units), comes out +1.5e-5: the ray hits the floor it
-  // leaves. 0.8 % of Conference's diffuse and shadow rays do so through
-  // bvh8:watertight:robust (the default build, whose leaf boxes around the
-  // floor have height). Möller-Trumbore, whose t is the plane's distance
-  // from a vertex, is exact here: the floor's normal has two zero
-  // components. See triangle_watertight.h for the bound that was tried.
+  // behind the origin. The paper's t, interpolated from the vertices'
+  // depths along the ray (up to 860 units), came out +1.5e-5, and 0.8 % of
+  // Conference's diffuse and shadow rays hit the floor they leave through
+  // bvh8:watertight:robust. The plane's distance from a vertex is exact
+  // here (the floor's normal has two zero components), as Moller-Trumbore's.
   const Triangle floor{{-0x1.d971aap+9f, -0x1.927914p+0f, 0x1.4e3e98p+9f},
                        {0x1.9d5p+10f, -0x1.927914p+0f, 0x1.4e3e98p+9f},
                        {0x1.9d5p+10f, -0x1.927914p+0f, -0x1.fc0cccp+9f}};
   const Ray leaving = ray({0x1.325598p+10f, -0x1.927714p+0f, -0x1.864acap+7f},
                           {-0x1.a5b518p-4f, 0x1.648a0cp-1f, -0x1.6ba7b6p-1f});
-  TriangleHit h;
-  ASSERT_TRUE(hits<WatertightTriangle>(leaving, floor, &h));
-  EXPECT_GT(h.t, 0.0f);
-  EXPECT_LT(h.t, 1e-4f);
+  EXPECT_FALSE(hits<WatertightTriangle>(leaving, floor));
   EXPECT_FALSE(hits<MollerTrumboreNormal>(leaving, floor));
+  // Back along the ray, the floor is hit at the origin's height over it.
+  TriangleHit h;
+  Ray back = leaving;
+  back.dir = leaving.dir * -1.0f;
+  ASSERT_TRUE(hits<WatertightTriangle>(back, floor, &h));
+  const float height = leaving.org.y - floor.v0.y;
+  EXPECT_NEAR(h.t * leaving.dir.y, height, 1e-3f * height);
+}
+
+TEST(Watertight, AHitWhoseDistanceOverflowsIsNotReportedAtInfinity) {
+  // The distance is 3e38 exactly, but n . (v0 - org) = 2 * -3e38 overflows
+  // in float: the plane's distance comes out +inf, which tmax = inf would
+  // accept. A hit has a finite t.
+  const Triangle twice_unit{{0, 0, 0}, {2, 0, 0}, {0, 1, 0}};
+  TriangleHit h{};
+  const bool hit = hits<WatertightTriangle>(ray({0.25f, 0.25f, 3e38f}, {0, 0, -1}), twice_unit, &h);
+  EXPECT_FALSE(hit && !std::isfinite(h.t)) << h.t;
 }
 
 TEST(MollerTrumbore, KnownFailure_LeaksThroughSharedEdgesOfAClosedMesh) {

@@ -63,8 +63,8 @@ inline int far_to_near_lane(const WideNode<W>& node, int octant, int rank) {
 // What a leaf pack stores: Möller–Trumbore's v0, e1, e2 and normal
 // (TrianglePack), the same without the normal, recomputed per test
 // (TriangleEdgePack: a quarter less memory), or the triangles' own vertices
-// for the watertight test (TriangleVertices8, 8-wide only: the edges must
-// not be rounded, or shared edges would no longer match).
+// and normals for the watertight test (TriangleVertices8, 8-wide only: the
+// edges must not be rounded, or shared edges would no longer match).
 enum class WideLeaves { kMollerTrumbore, kMollerTrumboreEdges, kVertices };
 
 // The order of a node's children in its lanes, which is the order any-hit

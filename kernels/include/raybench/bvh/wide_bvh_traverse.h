@@ -167,15 +167,20 @@ struct WideMollerTrumboreEdges : WideMollerTrumbore {
 
 struct Bvh8Watertight {
   static constexpr WideLeaves kLeaves = WideLeaves::kVertices;
-  static constexpr bool kPrimsInPack = true;  // TriangleVertices8::prim
+  // The packs carried their triangles' indices in the fifth cache line,
+  // which the test loaded anyway (+2-4 %, the terrain +7-13 %, against
+  // pack_prims at each hit). With the normals the test reads six lines and
+  // the indices would take a seventh: through pack slots instead, measured
+  // the same (interleaved, one thread, six scenes, three ray kinds) with a
+  // seventh less leaf memory.
+  static constexpr bool kPrimsInPack = false;
   using RayData = WatertightTriangle::RayData;
   RAYBENCH_INLINE static RayData precompute(const Ray& ray) { return WatertightTriangle::precompute(ray); }
   RAYBENCH_INLINE static int intersect(const RayData& ray, float tmax, const Bvh8& bvh, std::uint32_t pack, TriangleHit& out) {
     return intersect8_watertight(ray, tmax, bvh.vertex_packs[pack], out);
   }
-  // From the pack's own copy, in a line the test has just loaded.
   RAYBENCH_INLINE static std::int32_t prim(const Bvh8& bvh, std::uint32_t pack, int lane) {
-    return bvh.vertex_packs[pack].prim[lane];
+    return bvh.pack_prims[Bvh8::slot(pack, lane)];
   }
 };
 
@@ -190,8 +195,7 @@ struct Bvh8Watertight {
 // there, independent loads overlap; inside the traversal each could miss and
 // hold it up (measured for bvh8 against reading pack_prims at each hit,
 // interleaved, one thread, six scenes: diffuse rays +3.5 %, every scene
-// faster, primary +2.5 %, the terrain +6 % and +11 %; for the watertight
-// packs, which carry their triangles, 1-2 % slower: they do not use it).
+// faster, primary +2.5 %, the terrain +6 % and +11 %).
 template <bool AnyHit, typename Leaf = WideMollerTrumbore, typename BoxTest = SlabFma, bool PackSlots = false, int W>
 RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
   Hit hit;

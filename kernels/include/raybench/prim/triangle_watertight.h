@@ -10,34 +10,38 @@
 // a shared edge or vertex hits at least one of them: no cracks. When a
 // determinant is exactly 0 in float it is recomputed in double (the paper's
 // fallback), so the edge decision is exact for these inputs.
-// Two departures from the paper, both outside the edge test, so neither
-// opens a crack: the shear x - Sx*z is one fused multiply-add (a vertex still
-// gets the same sheared coordinates in every triangle that has it; the 2x2
-// determinants are not fused, which would break their antisymmetry), and
-// the distance interval is checked once, on the divided t, not first on the
-// scaled t as well (an early reject for scalar code; the 8-wide test divides
-// every lane anyway).
+// Three departures from the paper. Two are outside the edge test, so
+// neither opens a crack: the shear x - Sx*z is one fused multiply-add (a
+// vertex still gets the same sheared coordinates in every triangle that has
+// it; the 2x2 determinants are not fused, which would break their
+// antisymmetry), and the distance interval is checked once, on the divided
+// t, not first on the scaled t as well (an early reject for scalar code; the
+// 8-wide test divides every lane anyway).
+// The third is the hit's t. The paper interpolates it from the vertices'
+// sheared depths along the ray, T = U*Az + V*Bz + W*Cz over U+V+W, so its
+// error scales with the triangle's extent, not with t: a ray leaving a large
+// triangle hit it again just in front of its origin (Conference's floor,
+// 2,600 units across: t = +1.5e-5 where the exact distance is -4.4e-5; 0.8 %
+// of Conference's diffuse and shadow rays through bvh8:watertight:robust,
+// 0.09 % of Sponza's). Here t is the plane's distance from a vertex,
+// n . (v0 - org) / n . dir with n from the stored vertices' edges, as
+// Embree's Pluecker test and Moller-Trumbore compute it; it is exact for an
+// axis-aligned floor, whose normal has two zero components. The hit decision
+// (U, V, W) is the paper's, so the test stays watertight; only the distance
+// of a hit changes. Before it, pbrt-v4's remedy was built and reverted: a
+// hit only where the paper's t exceeds its error bound (Triangle::Intersect,
+// "ensure that computed triangle t is conservatively greater than zero").
+// It removed the self-hits (0.74 %, 0.79 % and 0.089 % to 0-0.006 %), but
+// the bound, which grows with the square of the depth over the triangle's
+// size, dropped true hits: far-origin rays 0.3 -> 3.1 % wrong on
+// Conference, 1.1 -> 15.5 % on Lucy, 12.6 -> 45 % on Sibenik; grazing
+// 0.02-0.3 -> 0.7-2.6 %; reintersection 0-0.09 -> 0.4-1.4 %; tiny
+// triangles 2.3 -> 6.3 %; and it cost 7 % speed.
 // Not culled: both faces hit. Degenerate triangles (U+V+W == 0) miss.
-//
-// Known failure: t is interpolated from the vertices' depths along the ray,
-// so its error scales with the triangle's extent, not with t. A ray leaving
-// a large triangle may hit it again just in front of its origin
-// (KnownFailure_ARayLeavingALargeTriangleHitsItAgain: 0.8 % of Conference's
-// diffuse and shadow rays through bvh8:watertight:robust). pbrt-v4's remedy,
-// a hit only where t exceeds its error bound (Triangle::Intersect, "ensure
-// that computed triangle t is conservatively greater than zero"), was
-// built, with its x and y error terms taken from the unscaled depth (pbrt
-// adds the scaled one, which rejected every hit of a short direction), and
-// measured with the accuracy suite: the self-hits went (Conference 0.74 %
-// and 0.79 %, Sponza 0.089 %, to 0-0.006 %), but the bound, which grows with
-// the square of the depth over the triangle's size, dropped true hits:
-// far-origin rays 0.3 -> 3.1 % wrong on Conference, 1.1 -> 15.5 % on Lucy,
-// 12.6 -> 45 % on Sibenik; grazing 0.02-0.3 -> 0.7-2.6 %; reintersection
-// 0-0.09 -> 0.4-1.4 %; tiny triangles 2.3 -> 6.3 %. It also cost
-// bvh8:watertight:robust 7 % computed for the lanes that hit. Reverted.
 #pragma once
 
 #include <cmath>
+#include <limits>
 #include <string_view>
 
 #include "raybench/math/inline.h"
@@ -58,11 +62,13 @@ struct WatertightTriangle {
     Vec3f org;
     float tnear;
     int kx, ky, kz;
-    float sx, sy, sz;
+    float sx, sy;
     // org[kx], org[ky], org[kz], set once per ray: indexed in the 8-wide
     // leaf, org[r.kx] compiled to two compares and branches per axis on the
     // origin GCC held in registers, about 20 instructions per leaf.
     float ox, oy, oz;
+    // -|dir[kz]|, for the hit's distance (plane_distance).
+    float minus_abs_dz;
   };
   // The axis choice and the swap are branches on the direction, which an
   // incoherent ray set mispredicts: a probe put this setup at 2-8 % of
@@ -85,8 +91,8 @@ struct WatertightTriangle {
     if (ray.dir[r.kz] < 0.0f) std::swap(r.kx, r.ky);  // keep the winding
     r.sx = ray.dir[r.kx] / ray.dir[r.kz];
     r.sy = ray.dir[r.ky] / ray.dir[r.kz];
-    r.sz = 1.0f / ray.dir[r.kz];
     r.ox = ray.org[r.kx], r.oy = ray.org[r.ky], r.oz = ray.org[r.kz];
+    r.minus_abs_dz = -std::fabs(ray.dir[r.kz]);
     return r;
   }
 
@@ -117,13 +123,46 @@ struct WatertightTriangle {
       if (outside(u, v, w)) return false;
     }
     const float det = u + v + w;
-    if (!(det != 0.0f)) return false;  // degenerate (or NaN)
-    const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
-    const float t_scaled = std::fma(u, az, std::fma(v, bz, w * cz));
+    // Degenerate, or NaN (an infinite origin: the 8-wide test's lanes are
+    // neither inside nor on an edge then).
+    if (!(std::fabs(det) > 0.0f)) return false;
     const float inv_det = 1.0f / det;
-    out = {t_scaled * inv_det, v * inv_det, w * inv_det};
-    return out.t > r.tnear && out.t <= tmax;
+    out = {plane_distance(r, normal(tri), a, det), v * inv_det, w * inv_det};
+    return out.t > r.tnear && out.t <= finite_tmax(tmax);
   }
+
+  // A ray inside the triangle by the edge test but parallel to its plane in
+  // float has an infinite distance: no hit, even for tmax = inf. A NaN tmax
+  // stays NaN (std::fmin would return the largest float), so nothing hits.
+  RAYBENCH_INLINE static float finite_tmax(float tmax) {
+    constexpr float kLargest = std::numeric_limits<float>::max();
+    return tmax > kLargest ? kLargest : tmax;
+  }
+
+  // The triangle's normal, (v1 - v0) x (v2 - v0) from its stored vertices:
+  // the 8-wide packs store it as computed here, so both forms get the same
+  // distance bit for bit.
+  static Vec3f normal(const Triangle& tri) {
+    const Vec3f e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
+    return {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
+  }
+
+  // The hit's t: the distance along the ray to the triangle's plane,
+  // n . (v0 - org) / n . dir, as Embree's Pluecker test and Moller-Trumbore
+  // compute it, with n = normal(tri), summed in the frame's axis order (kx,
+  // ky, kz). Not the paper's t, which is interpolated from the vertices'
+  // sheared depths along the ray: its error scales with the triangle's
+  // extent, not with t (see the header comment). n . dir is not summed: the
+  // shear maps dir to the frame's z axis, so n . dir = -det * |dir[kz]|,
+  // one product instead of three (det = U + V + W is the sheared edges' 2-D
+  // cross product with the opposite orientation, times 1 / dir[kz]; the
+  // frame (kx, ky, kz) is n's axes in a cyclic order when dir[kz] > 0 and
+  // swapped, flipping the cross product, when dir[kz] < 0).
+  RAYBENCH_INLINE static float plane_distance(const RayData& r, const Vec3f& n, const Vec3f& a, float det) {
+    const float along_normal = std::fma(n[r.kx], a[r.kx], std::fma(n[r.ky], a[r.ky], n[r.kz] * a[r.kz]));
+    return along_normal / (det * r.minus_abs_dz);
+  }
+
   static bool intersect(const Ray& ray, float tmax, const Triangle& tri, TriangleHit& out) {
     return intersect(precompute(ray), tmax, tri, out);
   }

@@ -5,7 +5,8 @@
 // hit exactly 0 in float (a ray through an edge or vertex) is recomputed by
 // the scalar test, which decides it in double as the paper prescribes.
 // The triangles' own vertices are stored (v1 = v0 + e1 would be rounded,
-// and neighbours must see bit-identical shared vertices), structure-of-arrays.
+// and neighbours must see bit-identical shared vertices), structure-of-arrays,
+// and their normals, for the hit's distance (the plane's, not the paper's).
 // AVX2 when the compiler targets it, else a scalar loop, same answers.
 #pragma once
 
@@ -19,15 +20,12 @@
 namespace raybench {
 
 struct alignas(64) TriangleVertices8 {
-  float v[3][3][8];  // [vertex][axis][lane]
-  // Each lane's input triangle index (-1: unused), as WideBvh::pack_prims
-  // holds them, set by the collapse. Here they fill the pack's fifth cache
-  // line, which the test has just loaded (its last vertex axis): a hit's
-  // triangle costs no load from another array, which could miss and hold
-  // up the traversal. Measured, interleaved, one thread,
-  // bvh8:watertight:robust: diffuse and primary rays +2-4 % (geometric
-  // means, two batches of six scenes), the million-triangle terrain +7-13 %.
-  std::int32_t prim[8] = {-1, -1, -1, -1, -1, -1, -1, -1};
+  // [vertex][axis][lane], then each lane's normal, WatertightTriangle::normal,
+  // as v[kNormal][axis][lane], for the hit's distance
+  // (WatertightTriangle::plane_distance). In one array with the vertices,
+  // the test reaches the normal at a constant offset from a vertex row.
+  static constexpr int kNormal = 3;
+  float v[4][3][8];
 
   // Packs up to 8 triangles; missing lanes get NaN and never hit.
   static TriangleVertices8 pack(std::span<const Triangle> tris) {
@@ -39,6 +37,7 @@ struct alignas(64) TriangleVertices8 {
         p.v[0][a][lane] = used ? tris[lane].v0[a] : nan;
         p.v[1][a][lane] = used ? tris[lane].v1[a] : nan;
         p.v[2][a][lane] = used ? tris[lane].v2[a] : nan;
+        p.v[kNormal][a][lane] = used ? WatertightTriangle::normal(tris[lane])[a] : nan;
       }
     }
     return p;
@@ -83,44 +82,51 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
   const float* px = t.v[0][r.kx];
   const float* py = t.v[0][r.ky];
   const float* pz = t.v[0][r.kz];
-  const __m256 sx = _mm256_set1_ps(r.sx), sy = _mm256_set1_ps(r.sy), sz = _mm256_set1_ps(r.sz);
+  const __m256 sx = _mm256_set1_ps(r.sx), sy = _mm256_set1_ps(r.sy);
   const __m256 ox = _mm256_set1_ps(r.ox), oy = _mm256_set1_ps(r.oy), oz = _mm256_set1_ps(r.oz);
-  // Vertex k relative to the origin, sheared: (x, y) in the ray's frame and its kz component.
-  __m256 x[3], y[3], z[3];
+  // Vertex k relative to the origin, (ax, ay, az) for the first one, and
+  // sheared: (x, y) in the ray's frame.
+  __m256 x[3], y[3], ax, ay, az;
   for (int k = 0; k < 3; ++k) {
-    z[k] = _mm256_sub_ps(_mm256_load_ps(pz + kVertex * k), oz);
-    x[k] = _mm256_fnmadd_ps(sx, z[k], _mm256_sub_ps(_mm256_load_ps(px + kVertex * k), ox));
-    y[k] = _mm256_fnmadd_ps(sy, z[k], _mm256_sub_ps(_mm256_load_ps(py + kVertex * k), oy));
+    const __m256 rx = _mm256_sub_ps(_mm256_load_ps(px + kVertex * k), ox);
+    const __m256 ry = _mm256_sub_ps(_mm256_load_ps(py + kVertex * k), oy);
+    const __m256 rz = _mm256_sub_ps(_mm256_load_ps(pz + kVertex * k), oz);
+    x[k] = _mm256_fnmadd_ps(sx, rz, rx);
+    y[k] = _mm256_fnmadd_ps(sy, rz, ry);
+    if (k == 0) ax = rx, ay = ry, az = rz;
   }
   const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
   const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
   const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
   const __m256 zero = _mm256_setzero_ps();
-  // Outside: the smallest determinant negative and the largest positive.
-  // Strictly inside: all three of one sign, none zero. min/max return one
-  // of their operands, so these say what the scalar test says; where a NaN
-  // hides a sign from them, neither holds for it (det is NaN too).
+  // Strictly inside: all three of one sign, none zero, so the smallest
+  // positive or the largest negative. On an edge in float: a zero among
+  // them and no two of opposite signs, so the smallest or the largest is
+  // zero (the scalar test's outside() fails, and it decides in double).
+  // min/max return one of their operands, so these say what the scalar
+  // test says on the lanes without NaN, and a lane whose u, v and w are all
+  // NaN (an unused one) is neither. A NaN that hides a sign from them
+  // leaves det NaN: no distance passes the interval, and the scalar test
+  // misses it.
   const __m256 smallest = _mm256_min_ps(_mm256_min_ps(u, v), w), largest = _mm256_max_ps(_mm256_max_ps(u, v), w);
-  const __m256 below = _mm256_cmp_ps(smallest, zero, _CMP_LT_OQ), above = _mm256_cmp_ps(largest, zero, _CMP_GT_OQ);
-  const __m256 outside = _mm256_and_ps(below, above);
   const __m256 inside = _mm256_or_ps(_mm256_cmp_ps(smallest, zero, _CMP_GT_OQ), _mm256_cmp_ps(largest, zero, _CMP_LT_OQ));
+  const int exact = _mm256_movemask_ps(_mm256_or_ps(_mm256_cmp_ps(smallest, zero, _CMP_EQ_OQ), _mm256_cmp_ps(largest, zero, _CMP_EQ_OQ)));
   const __m256 det = _mm256_add_ps(_mm256_add_ps(u, v), w);
-  // Neither outside nor strictly inside, and not NaN: on an edge in float,
-  // for the scalar test to decide in double.
-  const int exact = _mm256_movemask_ps(_mm256_andnot_ps(_mm256_or_ps(outside, inside), _mm256_cmp_ps(det, det, _CMP_ORD_Q)));
-  const __m256 t_scaled = _mm256_fmadd_ps(u, _mm256_mul_ps(sz, z[0]),
-                                          _mm256_fmadd_ps(v, _mm256_mul_ps(sz, z[1]), _mm256_mul_ps(w, _mm256_mul_ps(sz, z[2]))));
+  // The distance to each triangle's plane, as WatertightTriangle::plane_distance.
+  constexpr int kToNormal = kVertex * TriangleVertices8::kNormal;  // floats from a vertex-0 row to its normal row
+  const __m256 nx = _mm256_load_ps(px + kToNormal), ny = _mm256_load_ps(py + kToNormal), nz = _mm256_load_ps(pz + kToNormal);
+  const __m256 along_normal = _mm256_fmadd_ps(nx, ax, _mm256_fmadd_ps(ny, ay, _mm256_mul_ps(nz, az)));
   // Divided for every pack: returning first when no lane is inside or
   // exact saved the division but measured slower (interleaved, one thread,
   // bvh8:watertight:robust, five scenes: primary rays +3 %, diffuse and
   // shadow rays 1.5-5 % slower; the branch mispredicts). Nor did a
-  // return before the division on the scaled distance, which excludes the
-  // ray's own surface behind its origin (an inside lane in about half the
-  // packs a diffuse ray tests): with t_scaled and det of one sign, or with
-  // the paper's scaled interval test, 0 to -2.5 % (geometric means, same
-  // binaries interleaved, five scenes, three ray kinds, three rounds).
-  const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
-  const __m256 tt = _mm256_mul_ps(t_scaled, inv_det);
+  // return before the division on the paper's scaled distance (before the
+  // plane's distance replaced it), which excludes the ray's own surface
+  // behind its origin (an inside lane in about half the packs a diffuse ray
+  // tests): with the scaled t and det of one sign, or with the paper's
+  // scaled interval test, 0 to -2.5 % (geometric means, same binaries
+  // interleaved, five scenes, three ray kinds, three rounds).
+  const __m256 tt = _mm256_div_ps(along_normal, _mm256_mul_ps(det, _mm256_set1_ps(r.minus_abs_dz)));
   // A lane strictly inside has det != 0 (three nonzero values of one sign
   // do not sum to 0) and is never one of the exact lanes: no more tests.
   // Measured against testing det != 0 and on-edge lanes (u, v or w == 0)
@@ -128,19 +134,22 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
   // through bvh8:watertight:robust 2-3 % faster (11 rows of 6 scenes, two
   // batches), diffuse and primary within noise.
   const __m256 ok = _mm256_and_ps(inside, _mm256_and_ps(_mm256_cmp_ps(tt, _mm256_set1_ps(r.tnear), _CMP_GT_OQ),
-                                                        _mm256_cmp_ps(tt, _mm256_set1_ps(tmax), _CMP_LE_OQ)));
+                                                        _mm256_cmp_ps(tt, _mm256_set1_ps(WatertightTriangle::finite_tmax(tmax)), _CMP_LE_OQ)));
   int mask = _mm256_movemask_ps(ok);
   if (!mask && !exact) return -1;
-  alignas(32) float ts[8], us[8], vs[8];
+  // The barycentrics are divided for the closest lane only.
+  alignas(32) float ts[8], vs[8], ws[8], dets[8];
   _mm256_store_ps(ts, tt);
-  _mm256_store_ps(us, _mm256_mul_ps(v, inv_det));
-  _mm256_store_ps(vs, _mm256_mul_ps(w, inv_det));
+  _mm256_store_ps(vs, v);
+  _mm256_store_ps(ws, w);
+  _mm256_store_ps(dets, det);
+  int exact_hits = 0;
+  TriangleHit exact_hit[8];
   for (int lanes = exact; lanes; lanes &= lanes - 1) {
     const int lane = __builtin_ctz(static_cast<unsigned>(lanes));
-    TriangleHit h;
-    if (WatertightTriangle::intersect(r, tmax, t.lane(lane), h)) {
-      ts[lane] = h.t, us[lane] = h.u, vs[lane] = h.v;
-      mask |= 1 << lane;
+    if (WatertightTriangle::intersect(r, tmax, t.lane(lane), exact_hit[lane])) {
+      ts[lane] = exact_hit[lane].t;
+      mask |= 1 << lane, exact_hits |= 1 << lane;
     }
   }
   int best = -1;
@@ -148,7 +157,13 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
     const int lane = __builtin_ctz(static_cast<unsigned>(mask));
     if (best < 0 || ts[lane] <= ts[best]) best = lane;  // the scalar loop's tie rule
   }
-  if (best >= 0) out = {ts[best], us[best], vs[best]};
+  if (best < 0) return -1;
+  if (exact_hits >> best & 1) {
+    out = exact_hit[best];
+  } else {
+    const float inv_det = 1.0f / dets[best];  // as the scalar test
+    out = {ts[best], vs[best] * inv_det, ws[best] * inv_det};
+  }
   return best;
 }
 #endif
