@@ -3,7 +3,7 @@
 //
 // The ray is made the +z axis of a sheared frame (per ray: the dominant
 // direction axis kz, the two others kx, ky, swapped when dir[kz] < 0 to keep
-// the winding, and the shear Sx, Sy, Sz). In that frame the test is a 2-D
+// the winding, and the shear Sx, Sy). In that frame the test is a 2-D
 // point-in-triangle test at the origin with the scaled barycentrics
 // U, V, W computed as 2x2 determinants. Neighbouring triangles evaluate the
 // same determinant for a shared edge (with opposite sign), so a ray through
@@ -52,7 +52,7 @@ namespace raybench {
 
 struct WatertightTriangle {
   static constexpr std::string_view name = "watertight";
-  static constexpr std::string_view description = "Woop, Benthin & Wald 2013 (JCGT): sheared frame, no cracks on shared edges";
+  static constexpr std::string_view description = "Woop, Benthin & Wald 2013 (JCGT): sheared frame, no cracks on shared edges; t from the plane";
   static constexpr AccuracyClass accuracy = AccuracyClass::kWatertight;
 
   using Prepared = Triangle;
