@@ -247,7 +247,7 @@ def render(lines, meta, source, rows=(), plot=None):
            f"From `{os.path.basename(source)}`, one thread, ratios within the run."]
     m = meta.get("machine", {}) if isinstance(meta.get("machine"), dict) else {}
     machine = m or meta
-    facts = [f"{k}: {machine[k]}" for k in ("cpu", "cpu_model", "host", "compiler", "embree", "embree_version", "git_commit",
+    facts = [f"{k}: {machine[k]}" for k in ("cpu", "cpu_id", "cpu_model", "host", "compiler", "embree", "embree_version", "git_commit",
                                              "commit") if k in machine]
     if facts:
         out += ["", "Machine and build: " + "; ".join(str(f) for f in facts) + "."]

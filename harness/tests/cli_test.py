@@ -201,7 +201,7 @@ class SuiteRun(CliTestCase):
                 self.assertEqual(float(row["ratio_to_embree"]), 1.0)
         with open(os.path.join(self.dir, "results", "run.meta.toml"), "rb") as f:
             meta = tomllib.load(f)
-        for key in ("cpu", "compiler", "flags", "embree", "git_commit", "date", "threads"):
+        for key in ("cpu", "cpu_id", "compiler", "flags", "embree", "git_commit", "date", "threads"):
             self.assertTrue(meta[key], key)
         # The stored ray sets are reused by a second run: identical rays.
         stored = sorted(os.listdir(self.path("rays")))

@@ -113,9 +113,12 @@ TEST(ResultsCsv, AFileWithoutTheSchemaIsRejected) {
 TEST(Metadata, RecordsWhatAResultDependsOn) {
   const Metadata m = collect_metadata({{"threads", "2"}});
   std::map<std::string, std::string> keys(m.begin(), m.end());
-  for (const char* k : {"cpu", "compiler", "flags", "embree", "git_commit", "date", "threads"})
+  for (const char* k : {"cpu", "cpu_id", "compiler", "flags", "embree", "git_commit", "date", "threads"})
     EXPECT_FALSE(keys[k].empty()) << k;
   EXPECT_EQ(keys["embree"].rfind("3.", 0), 0u);
+  // The processor itself, where its model name is a virtual machine's generic one.
+  EXPECT_EQ(keys["cpu_id"].rfind("family ", 0), 0u) << keys["cpu_id"];
+  EXPECT_EQ(keys["cpu_id"].find('?'), std::string::npos) << keys["cpu_id"];
   EXPECT_EQ(metadata_path_for("results/latest.csv"), "results/latest.meta.toml");
 }
 
