@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <thread>
 
 #include <assimp/version.h>
@@ -20,42 +21,38 @@
 namespace raybench {
 namespace {
 
-std::string cpu_model() {
+// The first processor's entry of /proc/cpuinfo ("model name", "cpu family",
+// "flags", ...), read once for both CPU fields; empty where there is none.
+std::map<std::string, std::string> first_cpu_entry() {
   std::ifstream in("/proc/cpuinfo");
+  std::map<std::string, std::string> fields;
   std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) {
-      const auto colon = line.find(':');
-      if (colon != std::string::npos) return line.substr(line.find_first_not_of(' ', colon + 1));
-    }
+  while (std::getline(in, line) && !line.empty()) {  // a blank line ends the entry
+    const auto colon = line.find(':');
+    if (colon == std::string::npos) continue;
+    const auto key_end = line.find_last_not_of(" \t", colon - 1);
+    const auto value_start = line.find_first_not_of(" \t", colon + 1);
+    fields[line.substr(0, key_end == std::string::npos ? 0 : key_end + 1)] =
+        value_start == std::string::npos ? std::string() : line.substr(value_start);
   }
-  return "unknown";
+  return fields;
+}
+
+std::string field_or(const std::map<std::string, std::string>& fields, const std::string& key, const std::string& fallback) {
+  const auto it = fields.find(key);
+  return it == fields.end() || it->second.empty() ? fallback : it->second;
 }
 
 // A virtual machine's model name can be generic ("AMD EPYC" for Zen 4 and
 // Zen 5 alike, which traced our BVHs 19 % apart relative to Embree): the
 // family, model and stepping and the widest vector instructions say which.
-std::string cpu_id() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line, family = "?", model = "?", stepping = "?", isa = "sse";
-  const auto value = [&line] {
-    const auto colon = line.find(':');
-    const auto start = colon == std::string::npos ? colon : line.find_first_not_of(" \t", colon + 1);
-    return start == std::string::npos ? std::string() : line.substr(start);
-  };
-  while (std::getline(in, line)) {
-    if (line.rfind("cpu family", 0) == 0) family = value();
-    else if (line.rfind("model\t", 0) == 0) model = value();
-    else if (line.rfind("stepping", 0) == 0) stepping = value();
-    else if (line.rfind("flags", 0) == 0) {
-      std::string flags = value();  // padded with spaces, so that each flag is found as " name "
-      flags.insert(flags.begin(), ' ');
-      flags.push_back(' ');
-      isa = flags.find(" avx512f ") != std::string::npos ? "avx512f" : flags.find(" avx2 ") != std::string::npos ? "avx2" : "sse";
-      break;  // the first processor's entry is the machine's
-    }
-  }
-  return fmt::format("family {} model {} stepping {}, {}", family, model, stepping, isa);
+std::string cpu_id(const std::map<std::string, std::string>& cpu) {
+  std::string flags = field_or(cpu, "flags", "");  // padded, so that each flag is found as " name "
+  flags.insert(flags.begin(), ' ');
+  flags.push_back(' ');
+  const char* isa = flags.find(" avx512f ") != std::string::npos ? "avx512f" : flags.find(" avx2 ") != std::string::npos ? "avx2" : "sse";
+  return fmt::format("family {} model {} stepping {}, {}", field_or(cpu, "cpu family", "?"), field_or(cpu, "model", "?"),
+                     field_or(cpu, "stepping", "?"), isa);
 }
 
 std::string run_command(const std::string& command) {
@@ -100,11 +97,12 @@ Metadata collect_metadata(const Metadata& extra) {
   ::uname(&u);
   char host[256] = {};
   ::gethostname(host, sizeof host - 1);
+  const auto cpu = first_cpu_entry();
   Metadata m = {
       {"date", fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::chrono::system_clock::to_time_t(std::chrono::system_clock::now())))},
       {"host", host},
-      {"cpu", cpu_model()},
-      {"cpu_id", cpu_id()},
+      {"cpu", field_or(cpu, "model name", "unknown")},
+      {"cpu_id", cpu_id(cpu)},
       {"hardware_threads", std::to_string(std::thread::hardware_concurrency())},
       {"os", fmt::format("{} {} {}", u.sysname, u.release, u.machine)},
       {"compiler", RAYBENCH_COMPILER},
