@@ -32,12 +32,13 @@ struct alignas(64) TriangleVertices8 {
     TriangleVertices8 p;
     for (int lane = 0; lane < 8; ++lane) {
       const bool used = lane < static_cast<int>(tris.size());
+      const Vec3f normal = used ? WatertightTriangle::normal(tris[lane]) : Vec3f{};
       for (int a = 0; a < 3; ++a) {
         const float nan = std::numeric_limits<float>::quiet_NaN();
         p.v[0][a][lane] = used ? tris[lane].v0[a] : nan;
         p.v[1][a][lane] = used ? tris[lane].v1[a] : nan;
         p.v[2][a][lane] = used ? tris[lane].v2[a] : nan;
-        p.v[kNormal][a][lane] = used ? WatertightTriangle::normal(tris[lane])[a] : nan;
+        p.v[kNormal][a][lane] = used ? normal[a] : nan;
       }
     }
     return p;
