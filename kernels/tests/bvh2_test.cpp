@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include "bvh_test_util.h"
 
@@ -352,6 +353,50 @@ TEST_P(Bvh2Build, TheTreeDependsOnlyOnTheInput) {
   EXPECT_EQ(a.nodes.size(), b.nodes.size());
   EXPECT_EQ(a.sah_cost(), b.sah_cost());
   EXPECT_EQ(depth_of(a), depth_of(b));
+}
+
+// The nodes in depth-first order, children left first, each as its box and,
+// for a leaf, its primitives: the tree with the positions of its nodes in
+// the array left out.
+using NodeRecord = std::pair<std::array<float, 6>, std::vector<std::uint32_t>>;
+std::vector<NodeRecord> depth_first(const Bvh2& bvh) {
+  std::vector<NodeRecord> out;
+  std::vector<std::uint32_t> stack{0};
+  while (!stack.empty()) {
+    const Bvh2Node& n = bvh.nodes[stack.back()];
+    stack.pop_back();
+    std::vector<std::uint32_t> prims;
+    if (n.is_leaf()) {
+      prims.assign(bvh.prim_ids.begin() + n.first_index, bvh.prim_ids.begin() + n.first_index + n.prim_count);
+    } else {
+      stack.push_back(n.first_index + 1);
+      stack.push_back(n.first_index);
+    }
+    const BBox& b = n.bounds;
+    out.emplace_back(std::array{b.lower.x, b.lower.y, b.lower.z, b.upper.x, b.upper.y, b.upper.z}, std::move(prims));
+  }
+  return out;
+}
+
+// Which thread builds a subtree, and whether it goes to the tree's array
+// node by node or through a thread's scratch array (the binned builder,
+// below the parallel threshold), changes where its nodes lie, never the tree.
+TEST_P(Bvh2Build, TheTreeIsTheSameOnOneThreadOrTwoForAnyParallelThreshold) {
+  const auto tris = random_soup(12000, 12);
+  Bvh2BuildOptions options;
+  const auto reference = depth_first(build(tris, options));
+  ASSERT_EQ(reference.size() % 2, 1u);
+  for (const std::size_t threshold : {std::size_t{1}, std::size_t{1024}, std::size_t{5000}, tris.size() + 1}) {
+    for (const int threads : {1, 2}) {
+      SCOPED_TRACE(::testing::Message() << "parallel threshold " << threshold << ", " << threads << " threads");
+      options.parallel_threshold = threshold;
+      Bvh2 bvh;
+      tbb::task_arena(threads).execute([&] { bvh = build(tris, options); });
+      expect_valid(bvh, tris, options);
+      EXPECT_EQ(bvh.nodes.size(), reference.size());
+      EXPECT_TRUE(depth_first(bvh) == reference);
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Builders, Bvh2Build, ::testing::ValuesIn(kBvh2Builders),
