@@ -94,6 +94,10 @@ constexpr std::size_t kHalvedPartition = std::size_t{1} << 15;
 // (Builder::build_locally), whatever the parallel threshold: at most 4,093
 // nodes, 128 KiB per thread.
 constexpr std::size_t kMostLocalReferences = 2048;
+// A local build must spawn no task: waiting for one, its thread could take
+// up another range's local build, which would overwrite its scratch. Its
+// ranges are binned and partitioned in one pass each.
+static_assert(kMostLocalReferences <= 2 * bvh2_build::kBinningChunk && kMostLocalReferences <= kHalvedPartition);
 
 class Builder {
  public:
