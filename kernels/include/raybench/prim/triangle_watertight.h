@@ -142,10 +142,7 @@ struct WatertightTriangle {
   // The triangle's normal, (v1 - v0) x (v2 - v0) from its stored vertices:
   // the 8-wide packs store it as computed here, so both forms get the same
   // distance bit for bit.
-  static Vec3f normal(const Triangle& tri) {
-    const Vec3f e1 = tri.v1 - tri.v0, e2 = tri.v2 - tri.v0;
-    return {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
-  }
+  static Vec3f normal(const Triangle& tri) { return cross(tri.v1 - tri.v0, tri.v2 - tri.v0); }
 
   // The hit's t: the distance along the ray to the triangle's plane,
   // n . (v0 - org) / n . dir, as Embree's Pluecker test and Moller-Trumbore
