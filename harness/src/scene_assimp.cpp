@@ -8,6 +8,8 @@
 #include <assimp/scene.h>
 
 #include "error.h"
+#include "input_file.h"
+#include "ply_precheck.h"
 #include "procedural.h"
 #include "scene.h"
 
@@ -43,24 +45,18 @@ void collect(const aiScene& ai, const aiNode& node, const Eigen::Matrix4d& paren
   for (unsigned c = 0; c < node.mNumChildren; ++c) collect(ai, *node.mChildren[c], world, out);
 }
 
-// assimp 5.2's PLY reader loops forever on a header without "end_header" (a
-// file cut short inside its header): refuse such a file before assimp sees it.
+// Refuses, before assimp sees it, a PLY file whose header would hang assimp.
 void check_ply_header(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  std::string head(4, '\0');
-  if (!in.read(head.data(), 4) || (head != "ply\n" && head != "ply\r")) return;
-  std::string line;
-  for (int lines = 0; lines < 100000 && std::getline(in, line); ++lines) {
-    if (line.rfind("end_header", 0) == 0) return;
-  }
-  throw InputError(path, "malformed PLY: the header never ends (no end_header line)");
+  std::string head(kPlyPrecheckBytes, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  if (const std::string problem = ply_header_problem(head); !problem.empty()) throw InputError(path, problem);
 }
 
 Scene load_mesh_file(const std::string& path) {
   namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(path, "no such file");
-  if (fs::is_directory(path, ec)) throw InputError(path, "is a directory, not a mesh file");
+  check_input_file(path, "mesh file");
   if (!std::ifstream(path).good()) throw InputError(path, "cannot be opened for reading");
 
   check_ply_header(path);
