@@ -16,6 +16,7 @@
 #include "atomic_file.h"
 #include "error.h"
 #include "gbench.h"
+#include "interrupt.h"
 #include "metadata.h"
 #include "random.h"
 #include "raybench/simd/wide_box.h"
@@ -364,6 +365,7 @@ std::vector<KernelResult> run_kernel_benchmarks(const KernelBenchOptions& option
     r.ns_max = *std::max_element(r.samples.begin(), r.samples.end());
     results.push_back(std::move(r));
   }
+  const SignalsDeferred deferred;  // the CSV, its metadata and the JSON land together
   write_file_atomically(options.out_csv, [&](std::ostream& out) {
     const auto& columns = kernel_columns();
     for (std::size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << columns[i];
