@@ -35,6 +35,7 @@ Message g_messages[2];
 std::atomic<int> g_current{0};
 
 pthread_t g_main_thread;
+pid_t g_process = 0;  // the process that installed the handler
 std::atomic<bool> g_installed{false};
 
 static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free,
@@ -53,6 +54,9 @@ void write_all(const char* data, std::size_t size) {
 void write_text(const char* s) { write_all(s, std::strlen(s)); }
 
 extern "C" void on_interrupt(int signal) {
+  // A child forked by this process (e.g. to isolate a loader) inherits the
+  // handler but owns none of the files and is not the one to report.
+  if (::getpid() != g_process) ::_exit(128 + signal);
   if (!pthread_equal(pthread_self(), g_main_thread)) {
     // Another thread (a TBB worker, Embree's) caught it: the main thread does
     // the work, after any section it deferred signals for.
@@ -83,6 +87,7 @@ void set_signal_mask(int how, sigset_t* old) {
 void install_interrupt_handler() {
   if (g_installed.exchange(true)) return;
   g_main_thread = pthread_self();
+  g_process = ::getpid();
   set_interrupt_message("no results written");
   struct sigaction action {};
   action.sa_handler = on_interrupt;

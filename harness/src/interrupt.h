@@ -6,7 +6,8 @@
 // every scene); the handler only removes what is half-written.
 //
 // Guarantee: the handler calls only async-signal-safe functions (unlink,
-// write, pthread_kill, pthread_self, _exit). It does its work on the thread
+// write, getpid, pthread_kill, pthread_self, _exit). In a child process
+// forked from this one it only exits, 128 + the signal. It does its work on the thread
 // that installed it (the main thread, the only one that writes result files):
 // on another thread it forwards the signal there. So a file is never half
 // removed while that thread is creating it, and a section that blocks the
