@@ -38,7 +38,7 @@ double nearest_rank_percentile(std::vector<double>& values, double p);
 // by Hit::prim), the same exact t (same_exact_t, the referee's arithmetic).
 // Exact ties are what "not counting ties" means: two tracers rounding t
 // their own ways rarely return the same float for coincident triangles
-// (bvh8:watertight:robust against Embree, Sibenik's diffuse rays: 311 ties
+// (bvh8:watertight against Embree, Sibenik's diffuse rays: 311 ties
 // at the same float t, 443 more at the same exact t, none nearer or farther).
 Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference, std::span<const Ray> rays = {},
                        std::span<const Triangle> triangles = {});

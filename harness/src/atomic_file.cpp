@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "error.h"
+#include "interrupt.h"
 
 namespace raybench {
 
@@ -20,6 +21,7 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   }
   if (fs::is_directory(target, ec)) throw InputError(path, "is a directory");
   const std::string temp = path + ".tmp." + std::to_string(::getpid());
+  const RemoveOnInterrupt remove_temp(temp);  // registered before it exists, until it is renamed or removed
   {
     std::ofstream out(temp, mode | std::ios::trunc);
     if (!out) throw InputError(path, std::string("cannot be written: ") + std::strerror(errno));
@@ -44,9 +46,25 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   }
 }
 
+TemporaryFile::TemporaryFile(std::string path)
+    : path_(std::move(path)), on_interrupt_(std::make_unique<RemoveOnInterrupt>(path_)) {}
+
+TemporaryFile::~TemporaryFile() {
+  std::error_code ec;
+  if (on_interrupt_) std::filesystem::remove(path_, ec);
+}
+
+void TemporaryFile::keep_as(const std::string& target) {
+  std::error_code ec;
+  std::filesystem::rename(path_, target, ec);
+  if (ec) throw InputError(target, "cannot be replaced: " + ec.message());
+  on_interrupt_.reset();
+}
+
 void check_writable(const std::string& path) {
   std::error_code ec;
   const std::string probe = path + ".probe." + std::to_string(::getpid());
+  const RemoveOnInterrupt remove_probe(probe);
   write_file_atomically(probe, [](std::ostream&) {});
   std::filesystem::remove(probe, ec);
   if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory");

@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <optional>
 
 #include <Eigen/Geometry>
 #include <fmt/format.h>
@@ -16,6 +16,7 @@
 #include "atomic_file.h"
 #include "error.h"
 #include "gbench.h"
+#include "interrupt.h"
 #include "metadata.h"
 #include "random.h"
 #include "raybench/simd/wide_box.h"
@@ -301,6 +302,9 @@ const std::vector<std::string>& kernel_columns() {
 std::vector<KernelResult> run_kernel_benchmarks(const KernelBenchOptions& options) {
   if (options.repetitions < 1) throw InputError("", "--reps must be at least 1");
   if (options.pairs < 8) throw InputError("", "--pairs must be at least 8");
+  // Where the results go is checked before minutes of timing, not after.
+  check_writable(options.out_csv);
+  if (!options.out_json.empty()) check_writable(options.out_json);
   std::cerr << "raybench: making inputs (" << options.pairs << " pairs per family and input)" << std::endl;
   std::vector<Case> all;
   add_family<TriangleFamily>(all, options.pairs);
@@ -317,12 +321,14 @@ std::vector<KernelResult> run_kernel_benchmarks(const KernelBenchOptions& option
 
   for (Case& c : cases) c.result.hit_fraction = static_cast<double>(c.run()) / c.result.tests_per_iteration;
 
-  const std::string json_temp = options.out_json.empty() ? "" : options.out_json + ".tmp.gbench";
+  // Google Benchmark writes its JSON as it goes: into a temporary file that
+  // becomes out_json only when every result is written, and is removed on
+  // every other path (an error, a signal).
+  std::optional<TemporaryFile> json_temp;
   std::vector<std::string> flags = {"--benchmark_enable_random_interleaving=true"};
-  if (!json_temp.empty()) {
-    if (const auto parent = std::filesystem::path(options.out_json).parent_path(); !parent.empty())
-      std::filesystem::create_directories(parent);
-    flags.push_back("--benchmark_out=" + json_temp);
+  if (!options.out_json.empty()) {
+    json_temp.emplace(options.out_json + ".tmp.gbench");
+    flags.push_back("--benchmark_out=" + json_temp->path());
     flags.push_back("--benchmark_out_format=json");
   }
   initialize_google_benchmark(flags);
@@ -359,6 +365,7 @@ std::vector<KernelResult> run_kernel_benchmarks(const KernelBenchOptions& option
     r.ns_max = *std::max_element(r.samples.begin(), r.samples.end());
     results.push_back(std::move(r));
   }
+  const SignalsDeferred deferred;  // the CSV, its metadata and the JSON land together
   write_file_atomically(options.out_csv, [&](std::ostream& out) {
     const auto& columns = kernel_columns();
     for (std::size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << columns[i];
@@ -375,7 +382,7 @@ std::vector<KernelResult> run_kernel_benchmarks(const KernelBenchOptions& option
                                    {"repetitions", std::to_string(options.repetitions)},
                                    {"min_time_s", fmt::format("{}", options.min_time)},
                                    {"avx2", kHaveAvx2 ? "true" : "false"}}));
-  if (!json_temp.empty()) std::filesystem::rename(json_temp, options.out_json);
+  if (json_temp) json_temp->keep_as(options.out_json);
   return results;
 }
 

@@ -16,6 +16,7 @@
 #include "compare.h"
 #include "error.h"
 #include "atomic_file.h"
+#include "interrupt.h"
 #include "kernel_bench.h"
 #include "metadata.h"
 #include "npy.h"
@@ -367,6 +368,7 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     raybench::record_source_state();  // the sources as built, before a long run
+    raybench::install_interrupt_handler();  // SIGINT/SIGTERM: temporary files removed, exit 130/143 (interrupt.h)
     return raybench::run(argc, argv);
   } catch (const raybench::InputError& e) {
     std::cerr << "raybench: error: " << e.what() << std::endl;

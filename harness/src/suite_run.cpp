@@ -7,7 +7,9 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <new>
 #include <optional>
+#include <stdexcept>
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
@@ -20,6 +22,7 @@
 #include "build_timing.h"
 #include "error.h"
 #include "gbench.h"
+#include "interrupt.h"
 #include "metadata.h"
 #include "npy.h"
 #include "rayset.h"
@@ -79,6 +82,249 @@ LoadedScene load(const RunOptions& options, const std::string& name_or_path) {
   return loaded;
 }
 
+struct SceneResults {
+  std::vector<ResultRow> rows;
+  std::vector<AccuracyRow> accuracy;  // runs with RunOptions::accuracy_csv only
+};
+
+// One scene, scene `index` of `count`: its ray sets (made or reused), the
+// referee's verdicts (accuracy runs), every backend built, agreement with the
+// reference, and the timing of every case. No rows when no ray set applies.
+SceneResults measure_scene(const RunOptions& options, const LoadedScene& loaded, std::size_t index, std::size_t count) {
+  const Scene& scene = loaded.scene;
+  const SuiteScene* entry = loaded.entry;
+  const SuiteSettings& settings = options.settings;
+  SceneResults results;
+  progress(fmt::format("[{}/{}] {}: ray sets", index + 1, count, scene.name));
+  std::vector<RaySet> raysets;
+  {
+    const RayGenerator generator(scene);
+    const std::vector<std::string>& names =
+        options.raysets_from_command_line || !entry || entry->raysets.empty() ? settings.raysets : entry->raysets;
+    for (const std::string& name : names) {
+      const RaySetKind kind = parse_rayset_kind(name);
+      const std::optional<InsideBall> inside = entry ? entry->inside : std::nullopt;
+      if (is_must_hit(kind) && !inside) {
+        progress(fmt::format("  {}: skipped, the scene declares no inside ball (closed meshes only)", name));
+        continue;
+      }
+      RaySetSpec spec{kind, settings.rays, settings.seed, entry ? entry->camera : std::nullopt,
+                      entry ? entry->light : std::nullopt, inside};
+      RaySet set{kind, {}, {}, {}};
+      const bool want_sources = !options.accuracy_csv.empty() && has_sources(kind);
+      set.rays = obtain_rays(generator, scene, spec, options.rays_dir, want_sources ? &set.sources : nullptr);
+      raysets.push_back(std::move(set));
+    }
+  }
+  std::unique_ptr<Referee> referee;
+  if (!options.accuracy_csv.empty() && !raysets.empty()) {
+    const auto start = std::chrono::steady_clock::now();
+    referee = std::make_unique<Referee>(scene);
+    for (RaySet& rs : raysets) {
+      rs.truth.resize(rs.rays.size());
+      referee->judge(rs.rays, rs.truth);
+    }
+    progress(fmt::format("  referee: judged every ray exactly in {:.0f} ms",
+                         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()));
+  }
+  if (raysets.empty()) {
+    progress(fmt::format("[{}/{}] {}: no ray set applies, scene skipped", index + 1, count, scene.name));
+    return results;
+  }
+
+  struct Case {
+    std::string name;
+    ResultRow row;
+    std::optional<AccuracyRow> accuracy;
+    const Backend* backend;
+    const TraceExecutor* executor;
+    const RaySet* rayset;
+  };
+  std::vector<std::unique_ptr<TraceExecutor>> executors;
+  std::vector<std::unique_ptr<Backend>> backends;
+  std::vector<Case> cases;
+  for (int threads : settings.threads) {
+    executors.push_back(std::make_unique<TraceExecutor>(threads));
+    const TraceExecutor& executor = *executors.back();
+    // The reference's answers, per ray set, for agreement.
+    std::unique_ptr<Backend> reference = make_backend(kReferenceBackend, {threads});
+    executor.run([&] { reference->build(scene); });
+    std::vector<std::vector<Hit>> ref_hits(raysets.size());
+    std::vector<std::vector<std::uint8_t>> ref_occ(raysets.size());
+    for (std::size_t r = 0; r < raysets.size(); ++r) {
+      if (query_of(raysets[r].kind) == Query::kIntersect) {
+        ref_hits[r].resize(raysets[r].rays.size());
+        executor.intersect(*reference, raysets[r].rays, ref_hits[r]);
+      } else {
+        ref_occ[r].resize(raysets[r].rays.size());
+        executor.occluded(*reference, raysets[r].rays, ref_occ[r]);
+      }
+    }
+    reference.reset();
+
+    std::vector<Backend*> built;
+    for (const std::string& backend_name : settings.backends) {
+      backends.push_back(make_backend(backend_name, {threads}));
+      built.push_back(backends.back().get());
+    }
+    const std::vector<std::vector<double>> build_times =
+        time_builds_interleaved(built, scene, executor, settings.build_repetitions, settings.min_time);
+    for (std::size_t bi = 0; bi < built.size(); ++bi) {
+      const std::string& backend_name = settings.backends[bi];
+      const Backend* backend = built[bi];
+      const std::vector<double>& build_ms = build_times[bi];
+      progress(fmt::format("  built {} ({} threads) in {:.1f} ms, {:.1f} MiB", backend_name, threads, median(build_ms),
+                           backend->memory_bytes() / 1048576.0));
+      for (std::size_t r = 0; r < raysets.size(); ++r) {
+        const RaySet& rs = raysets[r];
+        ResultRow row;
+        row.scene = scene.name;
+        row.triangles = scene.triangles.size();
+        row.rayset = to_string(rs.kind);
+        row.query = to_string(query_of(rs.kind));
+        row.rays = rs.rays.size();
+        row.backend = backend_name;
+        row.threads = threads;
+        row.build_ms = median(build_ms);
+        row.build_ms_min = *std::min_element(build_ms.begin(), build_ms.end());
+        row.build_ms_max = *std::max_element(build_ms.begin(), build_ms.end());
+        row.memory_bytes = backend->memory_bytes();
+        row.sah_cost = backend->sah_cost();
+        Agreement a;
+        // Accuracy rows are single-run, single thread count: the first one.
+        std::optional<AccuracyRow> accuracy;
+        if (referee && threads == settings.threads.front()) {
+          accuracy.emplace();
+          accuracy->scene = scene.name;
+          if (entry) {
+            accuracy->scale = entry->scale;
+            accuracy->offset_x = entry->offset[0];
+            accuracy->offset_y = entry->offset[1];
+            accuracy->offset_z = entry->offset[2];
+          }
+          accuracy->rayset = row.rayset;
+          accuracy->query = row.query;
+          accuracy->backend = backend_name;
+          accuracy->accuracy_class = backend_accuracy_class(backend_name);
+        }
+        if (query_of(rs.kind) == Query::kIntersect) {
+          std::vector<Hit> hits(rs.rays.size());
+          executor.intersect(*backend, rs.rays, hits);
+          a = compare_hits(hits, ref_hits[r], rs.rays, scene.triangles);
+          if (accuracy) judge_hits(*referee, rs.rays, rs.truth, hits, rs.sources, *accuracy);
+        } else {
+          std::vector<std::uint8_t> occ(rs.rays.size());
+          executor.occluded(*backend, rs.rays, occ);
+          a = compare_occlusion(occ, ref_occ[r]);
+          if (accuracy) judge_occlusion(rs.rays, rs.truth, occ, *accuracy);
+        }
+        row.hit_rate = a.hit_rate();
+        row.agree_hit = a.agree_hit();
+        row.agree_prim = a.has_prims ? a.agree_prim() : std::nan("");
+        row.prim_ties = a.prim_ties;
+        row.t_relerr_max = a.has_prims ? a.t_relerr_max : std::nan("");
+        row.t_relerr_p999 = a.has_prims ? a.t_relerr_p999 : std::nan("");
+        row.disagreements = a.disagreements();
+        if (is_must_hit(rs.kind)) row.leaks = a.rays - a.hits;
+        const std::string name =
+            fmt::format("trace/{}/{}/{}/threads:{}", scene.name, row.rayset, backend_name, threads);
+        cases.push_back({name, row, accuracy, backend, &executor, &rs});
+      }
+    }
+  }
+
+  // Time every case of this scene in one Google Benchmark run, repetitions
+  // interleaved so that a noisy neighbour hits all backends alike.
+  benchmark::ClearRegisteredBenchmarks();
+  for (const Case& c : cases) {
+    const Case* cp = &c;
+    benchmark::RegisterBenchmark(c.name.c_str(),
+                                 [cp](benchmark::State& state) {
+                                   const std::vector<Ray>& rays = cp->rayset->rays;
+                                   std::vector<Hit> hits;
+                                   std::vector<std::uint8_t> occ;
+                                   const bool intersect = query_of(cp->rayset->kind) == Query::kIntersect;
+                                   if (intersect) hits.resize(rays.size());
+                                   else occ.resize(rays.size());
+                                   for (auto _ : state) {
+                                     if (intersect) cp->executor->intersect(*cp->backend, rays, hits);
+                                     else cp->executor->occluded(*cp->backend, rays, occ);
+                                     benchmark::DoNotOptimize(hits.data());
+                                     benchmark::DoNotOptimize(occ.data());
+                                     benchmark::ClobberMemory();
+                                   }
+                                   state.counters["rays"] = benchmark::Counter(static_cast<double>(rays.size()),
+                                                                               benchmark::Counter::kIsIterationInvariantRate);
+                                 })
+        ->Repetitions(settings.repetitions)
+        ->MinTime(settings.min_time)
+        ->MinWarmUpTime(settings.warmup)
+        ->UseRealTime()
+        ->Unit(benchmark::kMillisecond);
+  }
+  progress(fmt::format("[{}/{}] {}: timing {} cases x {} repetitions", index + 1, count, scene.name, cases.size(),
+                       settings.repetitions));
+  CollectingReporter reporter("rays", 1e-6, "Mrays/s", cases.size());
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::ClearRegisteredBenchmarks();
+  for (Case& c : cases) {
+    const std::vector<double>& s = reporter.samples(c.name);
+    c.row.mrays_s_samples = s;
+    c.row.reps = static_cast<int>(s.size());
+    c.row.mrays_s = median(s);
+    c.row.mrays_s_min = *std::min_element(s.begin(), s.end());
+    c.row.mrays_s_max = *std::max_element(s.begin(), s.end());
+  }
+  // Ratios to Embree measured in the same run: they survive a change of
+  // machine. The Embree row is in this scene, so they are final here.
+  for (Case& c : cases) {
+    for (const Case& ref : cases) {
+      if (ref.row.backend == kReferenceBackend && ref.row.rayset == c.row.rayset && ref.row.threads == c.row.threads &&
+          ref.row.mrays_s > 0)
+        c.row.ratio_to_embree = c.row.mrays_s / ref.row.mrays_s;
+    }
+    results.rows.push_back(c.row);
+    if (c.accuracy) {
+      c.accuracy->mrays_s = c.row.mrays_s;
+      c.accuracy->mrays_s_min = c.row.mrays_s_min;
+      c.accuracy->mrays_s_max = c.row.mrays_s_max;
+      results.accuracy.push_back(*c.accuracy);
+    }
+  }
+  return results;
+}
+
+std::string partial_results_note(const RunOptions& options, std::size_t finished, std::size_t total) {
+  return fmt::format("partial results ({} of {} scenes) in {}{}", finished, total, options.out_csv,
+                     options.accuracy_csv.empty() ? "" : " and " + options.accuracy_csv);
+}
+
+// Rewrites the results (and accuracy) CSV with every finished row, and their
+// metadata with status = "partial" and progress = "<k> of <n> scenes", or
+// status = "complete" when every scene is done. Signals wait until a CSV and
+// its metadata agree. Returns `finished`.
+std::size_t write_finished_scenes(const RunOptions& options, const Metadata& run_description,
+                                  const std::vector<ResultRow>& rows, const std::vector<AccuracyRow>& accuracy_rows,
+                                  std::size_t finished, std::size_t total) {
+  Metadata extra = run_description;
+  extra.emplace_back("status", finished == total ? "complete" : "partial");
+  extra.emplace_back("progress", fmt::format("{} of {} scenes", finished, total));
+  const Metadata metadata = collect_metadata(extra);
+  const SignalsDeferred deferred;
+  write_results_csv(options.out_csv, rows);
+  write_metadata(metadata_path_for(options.out_csv), metadata);
+  if (!options.accuracy_csv.empty()) {
+    write_accuracy_csv(options.accuracy_csv, accuracy_rows);
+    write_metadata(metadata_path_for(options.accuracy_csv), metadata);
+  }
+  set_interrupt_message(finished == total
+                            ? fmt::format("the run had finished; results in {}{}", options.out_csv,
+                                          options.accuracy_csv.empty() ? "" : " and " + options.accuracy_csv)
+                            : partial_results_note(options, finished, total));
+  if (finished < total) progress(partial_results_note(options, finished, total));
+  return finished;
+}
+
 }  // namespace
 
 std::vector<ResultRow> run_suite(const RunOptions& options) {
@@ -110,214 +356,9 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
                              : ""));
   }
 
-  initialize_google_benchmark(
-      {fmt::format("--benchmark_enable_random_interleaving={}", options.interleave ? "true" : "false")});
-  std::vector<ResultRow> rows;
-  std::vector<AccuracyRow> accuracy_rows;
-  for (std::size_t si = 0; si < scenes.size(); ++si) {
-    const Scene& scene = scenes[si].scene;
-    const SuiteScene* entry = scenes[si].entry;
-    progress(fmt::format("[{}/{}] {}: ray sets", si + 1, scenes.size(), scene.name));
-    std::vector<RaySet> raysets;
-    {
-      const RayGenerator generator(scene);
-      const std::vector<std::string>& names =
-          options.raysets_from_command_line || !entry || entry->raysets.empty() ? settings.raysets : entry->raysets;
-      for (const std::string& name : names) {
-        const RaySetKind kind = parse_rayset_kind(name);
-        const std::optional<InsideBall> inside = entry ? entry->inside : std::nullopt;
-        if (is_must_hit(kind) && !inside) {
-          progress(fmt::format("  {}: skipped, the scene declares no inside ball (closed meshes only)", name));
-          continue;
-        }
-        RaySetSpec spec{kind, settings.rays, settings.seed, entry ? entry->camera : std::nullopt,
-                        entry ? entry->light : std::nullopt, inside};
-        RaySet set{kind, {}, {}, {}};
-        const bool want_sources = !options.accuracy_csv.empty() && has_sources(kind);
-        set.rays = obtain_rays(generator, scene, spec, options.rays_dir, want_sources ? &set.sources : nullptr);
-        raysets.push_back(std::move(set));
-      }
-    }
-    std::unique_ptr<Referee> referee;
-    if (!options.accuracy_csv.empty() && !raysets.empty()) {
-      const auto start = std::chrono::steady_clock::now();
-      referee = std::make_unique<Referee>(scene);
-      for (RaySet& rs : raysets) {
-        rs.truth.resize(rs.rays.size());
-        referee->judge(rs.rays, rs.truth);
-      }
-      progress(fmt::format("  referee: judged every ray exactly in {:.0f} ms",
-                           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()));
-    }
-    if (raysets.empty()) {
-      progress(fmt::format("[{}/{}] {}: no ray set applies, scene skipped", si + 1, scenes.size(), scene.name));
-      continue;
-    }
-
-    struct Case {
-      std::string name;
-      ResultRow row;
-      std::optional<AccuracyRow> accuracy;
-      const Backend* backend;
-      const TraceExecutor* executor;
-      const RaySet* rayset;
-    };
-    std::vector<std::unique_ptr<TraceExecutor>> executors;
-    std::vector<std::unique_ptr<Backend>> backends;
-    std::vector<Case> cases;
-    for (int threads : settings.threads) {
-      executors.push_back(std::make_unique<TraceExecutor>(threads));
-      const TraceExecutor& executor = *executors.back();
-      // The reference's answers, per ray set, for agreement.
-      std::unique_ptr<Backend> reference = make_backend(kReferenceBackend, {threads});
-      executor.run([&] { reference->build(scene); });
-      std::vector<std::vector<Hit>> ref_hits(raysets.size());
-      std::vector<std::vector<std::uint8_t>> ref_occ(raysets.size());
-      for (std::size_t r = 0; r < raysets.size(); ++r) {
-        if (query_of(raysets[r].kind) == Query::kIntersect) {
-          ref_hits[r].resize(raysets[r].rays.size());
-          executor.intersect(*reference, raysets[r].rays, ref_hits[r]);
-        } else {
-          ref_occ[r].resize(raysets[r].rays.size());
-          executor.occluded(*reference, raysets[r].rays, ref_occ[r]);
-        }
-      }
-      reference.reset();
-
-      std::vector<Backend*> built;
-      for (const std::string& backend_name : settings.backends) {
-        backends.push_back(make_backend(backend_name, {threads}));
-        built.push_back(backends.back().get());
-      }
-      const std::vector<std::vector<double>> build_times =
-          time_builds_interleaved(built, scene, executor, settings.build_repetitions, settings.min_time);
-      for (std::size_t bi = 0; bi < built.size(); ++bi) {
-        const std::string& backend_name = settings.backends[bi];
-        const Backend* backend = built[bi];
-        const std::vector<double>& build_ms = build_times[bi];
-        progress(fmt::format("  built {} ({} threads) in {:.1f} ms, {:.1f} MiB", backend_name, threads, median(build_ms),
-                             backend->memory_bytes() / 1048576.0));
-        for (std::size_t r = 0; r < raysets.size(); ++r) {
-          const RaySet& rs = raysets[r];
-          ResultRow row;
-          row.scene = scene.name;
-          row.triangles = scene.triangles.size();
-          row.rayset = to_string(rs.kind);
-          row.query = to_string(query_of(rs.kind));
-          row.rays = rs.rays.size();
-          row.backend = backend_name;
-          row.threads = threads;
-          row.build_ms = median(build_ms);
-          row.build_ms_min = *std::min_element(build_ms.begin(), build_ms.end());
-          row.build_ms_max = *std::max_element(build_ms.begin(), build_ms.end());
-          row.memory_bytes = backend->memory_bytes();
-          row.sah_cost = backend->sah_cost();
-          Agreement a;
-          // Accuracy rows are single-run, single thread count: the first one.
-          std::optional<AccuracyRow> accuracy;
-          if (referee && threads == settings.threads.front()) {
-            accuracy.emplace();
-            accuracy->scene = scene.name;
-            if (entry) {
-              accuracy->scale = entry->scale;
-              accuracy->offset_x = entry->offset[0];
-              accuracy->offset_y = entry->offset[1];
-              accuracy->offset_z = entry->offset[2];
-            }
-            accuracy->rayset = row.rayset;
-            accuracy->query = row.query;
-            accuracy->backend = backend_name;
-            accuracy->accuracy_class = backend_accuracy_class(backend_name);
-          }
-          if (query_of(rs.kind) == Query::kIntersect) {
-            std::vector<Hit> hits(rs.rays.size());
-            executor.intersect(*backend, rs.rays, hits);
-            a = compare_hits(hits, ref_hits[r], rs.rays, scene.triangles);
-            if (accuracy) judge_hits(*referee, rs.rays, rs.truth, hits, rs.sources, *accuracy);
-          } else {
-            std::vector<std::uint8_t> occ(rs.rays.size());
-            executor.occluded(*backend, rs.rays, occ);
-            a = compare_occlusion(occ, ref_occ[r]);
-            if (accuracy) judge_occlusion(rs.rays, rs.truth, occ, *accuracy);
-          }
-          row.hit_rate = a.hit_rate();
-          row.agree_hit = a.agree_hit();
-          row.agree_prim = a.has_prims ? a.agree_prim() : std::nan("");
-          row.prim_ties = a.prim_ties;
-          row.t_relerr_max = a.has_prims ? a.t_relerr_max : std::nan("");
-          row.t_relerr_p999 = a.has_prims ? a.t_relerr_p999 : std::nan("");
-          row.disagreements = a.disagreements();
-          if (is_must_hit(rs.kind)) row.leaks = a.rays - a.hits;
-          const std::string name =
-              fmt::format("trace/{}/{}/{}/threads:{}", scene.name, row.rayset, backend_name, threads);
-          cases.push_back({name, row, accuracy, backend, &executor, &rs});
-        }
-      }
-    }
-
-    // Time every case of this scene in one Google Benchmark run, repetitions
-    // interleaved so that a noisy neighbour hits all backends alike.
-    benchmark::ClearRegisteredBenchmarks();
-    for (const Case& c : cases) {
-      const Case* cp = &c;
-      benchmark::RegisterBenchmark(c.name.c_str(),
-                                   [cp](benchmark::State& state) {
-                                     const std::vector<Ray>& rays = cp->rayset->rays;
-                                     std::vector<Hit> hits;
-                                     std::vector<std::uint8_t> occ;
-                                     const bool intersect = query_of(cp->rayset->kind) == Query::kIntersect;
-                                     if (intersect) hits.resize(rays.size());
-                                     else occ.resize(rays.size());
-                                     for (auto _ : state) {
-                                       if (intersect) cp->executor->intersect(*cp->backend, rays, hits);
-                                       else cp->executor->occluded(*cp->backend, rays, occ);
-                                       benchmark::DoNotOptimize(hits.data());
-                                       benchmark::DoNotOptimize(occ.data());
-                                       benchmark::ClobberMemory();
-                                     }
-                                     state.counters["rays"] = benchmark::Counter(static_cast<double>(rays.size()),
-                                                                                 benchmark::Counter::kIsIterationInvariantRate);
-                                   })
-          ->Repetitions(settings.repetitions)
-          ->MinTime(settings.min_time)
-          ->MinWarmUpTime(settings.warmup)
-          ->UseRealTime()
-          ->Unit(benchmark::kMillisecond);
-    }
-    progress(fmt::format("[{}/{}] {}: timing {} cases x {} repetitions", si + 1, scenes.size(), scene.name, cases.size(),
-                         settings.repetitions));
-    CollectingReporter reporter("rays", 1e-6, "Mrays/s", cases.size());
-    benchmark::RunSpecifiedBenchmarks(&reporter);
-    benchmark::ClearRegisteredBenchmarks();
-    for (Case& c : cases) {
-      const std::vector<double>& s = reporter.samples(c.name);
-      c.row.mrays_s_samples = s;
-      c.row.reps = static_cast<int>(s.size());
-      c.row.mrays_s = median(s);
-      c.row.mrays_s_min = *std::min_element(s.begin(), s.end());
-      c.row.mrays_s_max = *std::max_element(s.begin(), s.end());
-      rows.push_back(c.row);
-      if (c.accuracy) {
-        c.accuracy->mrays_s = c.row.mrays_s;
-        c.accuracy->mrays_s_min = c.row.mrays_s_min;
-        c.accuracy->mrays_s_max = c.row.mrays_s_max;
-        accuracy_rows.push_back(*c.accuracy);
-      }
-    }
-  }
-
-  // Ratios to Embree measured in the same run: they survive a change of machine.
-  for (ResultRow& row : rows) {
-    for (const ResultRow& ref : rows) {
-      if (ref.backend == kReferenceBackend && ref.scene == row.scene && ref.rayset == row.rayset &&
-          ref.threads == row.threads && ref.mrays_s > 0)
-        row.ratio_to_embree = row.mrays_s / ref.mrays_s;
-    }
-  }
-
   std::vector<std::string> scene_names;
   for (const auto& s : scenes) scene_names.push_back(s.scene.name);
-  const Metadata metadata = collect_metadata({
+  const Metadata run_description = {
       {"command", options.command_line},
       {"suite", options.suite.path},
       {"scenes", fmt::format("{}", fmt::join(scene_names, ","))},
@@ -331,14 +372,31 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
       {"warmup_s", fmt::format("{}", settings.warmup)},
       {"interleaved", options.interleave ? "true" : "false"},
       {"reference_backend", kReferenceBackend},
-  });
-  write_results_csv(options.out_csv, rows);
-  write_metadata(metadata_path_for(options.out_csv), metadata);
-  if (!options.accuracy_csv.empty()) {
-    write_accuracy_csv(options.accuracy_csv, accuracy_rows);
-    write_metadata(metadata_path_for(options.accuracy_csv), metadata);
-    progress(fmt::format("accuracy: {} ({} rows)", options.accuracy_csv, accuracy_rows.size()));
+  };
+
+  initialize_google_benchmark(
+      {fmt::format("--benchmark_enable_random_interleaving={}", options.interleave ? "true" : "false")});
+  std::vector<ResultRow> rows;
+  std::vector<AccuracyRow> accuracy_rows;
+  std::size_t finished = 0;  // scenes whose rows are on disk
+  set_interrupt_message(fmt::format("no scene had finished; nothing written to {}", options.out_csv));
+  try {
+    for (std::size_t si = 0; si < scenes.size(); ++si) {
+      SceneResults scene = measure_scene(options, scenes[si], si, scenes.size());
+      rows.insert(rows.end(), scene.rows.begin(), scene.rows.end());
+      accuracy_rows.insert(accuracy_rows.end(), scene.accuracy.begin(), scene.accuracy.end());
+      finished = write_finished_scenes(options, run_description, rows, accuracy_rows, si + 1, scenes.size());
+    }
+  } catch (const std::exception& e) {
+    // What is on disk stays: the error says where, so that minutes of
+    // measurement are not lost to a failure in a later scene.
+    if (finished == 0) throw;
+    const std::string what = dynamic_cast<const std::bad_alloc*>(&e) ? "out of memory" : e.what();
+    throw std::runtime_error(fmt::format("{} (in scene {} of {}); {}", what, finished + 1, scenes.size(),
+                                         partial_results_note(options, finished, scenes.size())));
   }
+  if (!options.accuracy_csv.empty())
+    progress(fmt::format("accuracy: {} ({} rows)", options.accuracy_csv, accuracy_rows.size()));
   return rows;
 }
 
