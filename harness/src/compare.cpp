@@ -171,9 +171,14 @@ std::vector<double> ratio_samples(const RowIndex& index, const Row& row) {
 
 std::string percent(double change) { return fmt::format("{:+.1f}%", 100.0 * change); }
 
+// A JSON string literal (RFC 8259: quote, backslash and control characters escaped).
 std::string json_string(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
+    if (static_cast<unsigned char>(c) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      continue;
+    }
     if (c == '"' || c == '\\') out += '\\';
     out += c;
   }
@@ -226,8 +231,8 @@ ResultsFile read_results_file(const std::string& path) {
 std::vector<std::string> partial_notes(const ResultsFile& f) {
   std::vector<std::string> out;
   for (const PartialFile& p : f.partial)
-    out.push_back(fmt::format("{} is partial ({}): the run stopped before its last scene, so rows of unfinished "
-                              "scenes are missing",
+    out.push_back(fmt::format("{} is partial ({}): its run was interrupted or is still going, so the rows of its "
+                              "unfinished scenes are missing",
                               p.path, p.progress.empty() ? "progress unknown" : p.progress));
   return out;
 }

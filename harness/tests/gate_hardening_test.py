@@ -200,6 +200,15 @@ class SpreadsheetFiles(GateTestCase):
         self.assertEqual(len(json.loads(compared.stdout)["rows"]), 4)
 
 
+class JsonOutput(GateTestCase):
+    def test_a_control_character_in_a_name_is_escaped(self):
+        rows = [row("tab\there"), row("tab\there", "bvh2")]
+        path = self.write("tab", rows)
+        result = run("compare", path, path, "--format", "json")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertEqual(json.loads(result.stdout)["rows"][0]["scene"], "tab\there")
+
+
 class PartialFiles(GateTestCase):
     PARTIAL = METADATA + 'status = "partial"\nprogress = "1 of 2 scenes"\n'
 
