@@ -30,9 +30,13 @@
 //   backend other than Embree without the Embree row of its scene, ray set
 //   and threads: its ratio to Embree, what the gate checks, has no reference
 //   (the baseline must be measured with the embree backend).
-//   FAIL, the gate's current runs (run_gate): a baseline row whose Embree row
-//   is absent from a current run (its ratio cannot be checked, whatever
-//   fail_on_missing_rows says), besides the regressions of GateConfig.
+//   FAIL, the gate's current runs (run_gate), besides the regressions of
+//   GateConfig: a baseline row whose Embree row is absent from a current run
+//   (its ratio cannot be checked there, whatever fail_on_missing_rows says);
+//   agree_hit, agree_prim or leaks that the baseline recorded and the current
+//   run left empty. A baseline is a reference someone chose and must
+//   regenerate if it is wrong; a current run is the code under test, and what
+//   it fails to record is its failure.
 //   Partial files (a run still going or interrupted: metadata status =
 //   "partial") are read; compare and gate print a note naming the file and
 //   its progress.

@@ -32,6 +32,7 @@ struct MannWhitney {
 };
 
 // The exact test where mann_whitney_exact_affordable, else the normal approximation.
+// The values must not be NaN (they are ranked; compare.h refuses such samples).
 MannWhitney mann_whitney_u(std::span<const double> x, std::span<const double> y);
 
 // Whether samples of these sizes are counted exactly (see above).
