@@ -7,7 +7,10 @@
 
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
+
+#include <fmt/format.h>
 
 #include "results_csv.h"
 #include "test_util.h"
@@ -32,16 +35,21 @@ Fields row(const Fields& changes = {}) {
   return r;
 }
 
+// One CSV line: the schema's columns of `r` (or their names), and a newline.
+std::string line_of(const Fields* r) {
+  std::string line;
+  for (const std::string& c : result_columns()) {
+    if (!line.empty()) line += ',';
+    line += r ? r->at(c) : c;
+  }
+  line += '\n';
+  return line;
+}
+
 // The CSV text of `rows` under the schema's header.
 std::string csv(const std::vector<Fields>& rows) {
-  std::string out;
-  for (const std::string& c : result_columns()) out += (out.empty() ? "" : ",") + c;
-  out += "\n";
-  for (const Fields& r : rows) {
-    std::string line;
-    for (const std::string& c : result_columns()) line += (line.empty() ? "" : ",") + r.at(c);
-    out += line + "\n";
-  }
+  std::string out = line_of(nullptr);
+  for (const Fields& r : rows) out += line_of(&r);
   return out;
 }
 
@@ -204,20 +212,15 @@ TEST(Gate, APartialRunIsNamedInANote) {
 
 // 100,000 rows: 50,000 scenes, each an Embree row and a bvh2 row beside it.
 std::string many_rows(double bvh2_scale) {
-  std::string out;
-  for (const std::string& c : result_columns()) out += (out.empty() ? "" : ",") + c;
-  out += "\n";
+  std::string out = line_of(nullptr);
   Fields r = row();
-  std::vector<std::string> values;
   for (int scene = 0; scene < 50000; ++scene)
     for (const char* backend : {"embree", "bvh2"}) {
-      r["scene"] = "s" + std::to_string(scene);
+      r["scene"] = fmt::format("s{}", scene);
       r["backend"] = backend;
-      const double m = backend == std::string("embree") ? 10.0 : 10.0 * bvh2_scale;
-      r["mrays_s_samples"] = std::to_string(m) + ";" + std::to_string(m * 1.01) + ";" + std::to_string(m * 0.99);
-      std::string line;
-      for (const std::string& c : result_columns()) line += (line.empty() ? "" : ",") + r.at(c);
-      out += line + "\n";
+      const double m = backend == std::string_view("embree") ? 10.0 : 10.0 * bvh2_scale;
+      r["mrays_s_samples"] = fmt::format("{};{};{}", m, m * 1.01, m * 0.99);
+      out += line_of(&r);
     }
   return out;
 }
