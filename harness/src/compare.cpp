@@ -119,7 +119,8 @@ void check_row(const ResultsFile& f, std::size_t i) {
     throw bad("leaks", fmt::format("'{}' is not a count of rays (empty, or a whole number >= 0)", leaks));
 }
 
-// Rows of a backend other than Embree without the Embree row beside them.
+// Throws InputError naming the first row of a backend other than Embree
+// without the Embree row of its scene, ray set and threads in the same file.
 void require_reference_rows(const ResultsFile& f) {
   const RowIndex index(f);
   for (std::size_t i = 0; i < f.rows.size(); ++i)
