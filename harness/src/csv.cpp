@@ -48,17 +48,26 @@ std::string csv_text(const std::string& s) {
 }
 
 std::vector<std::map<std::string, std::string>> read_csv_rows(const std::string& path,
-                                                              const std::vector<std::string>& required) {
-  std::ifstream in(path);
+                                                              const std::vector<std::string>& required,
+                                                              std::vector<std::size_t>* lines) {
+  if (lines) lines->clear();
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "cannot be opened for reading");
   std::string line;
-  if (!std::getline(in, line)) throw InputError(path, "empty file, expected a CSV header");
+  // One line without its end, LF or CRLF.
+  const auto next_line = [&] {
+    if (!std::getline(in, line)) return false;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  };
+  if (!next_line()) throw InputError(path, "empty file, expected a CSV header");
+  if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte order mark
   const std::vector<std::string> header = split_csv_line(line);
   for (const std::string& c : required)
     if (std::find(header.begin(), header.end(), c) == header.end()) throw InputError(path, "missing column '" + c + "'");
   std::vector<std::map<std::string, std::string>> rows;
   std::size_t line_number = 1;
-  while (std::getline(in, line)) {
+  while (next_line()) {
     ++line_number;
     if (line.empty()) continue;
     const std::vector<std::string> fields = split_csv_line(line);
@@ -67,6 +76,7 @@ std::vector<std::map<std::string, std::string>> read_csv_rows(const std::string&
     std::map<std::string, std::string> row;
     for (std::size_t i = 0; i < header.size(); ++i) row[header[i]] = fields[i];
     rows.push_back(std::move(row));
+    if (lines) lines->push_back(line_number);
   }
   return rows;
 }

@@ -53,11 +53,12 @@ void write_results_csv(const std::string& path, const std::vector<ResultRow>& ro
   });
 }
 
-std::vector<std::map<std::string, std::string>> read_results_csv(const std::string& path) {
+std::vector<std::map<std::string, std::string>> read_results_csv(const std::string& path,
+                                                                 std::vector<std::size_t>* lines) {
   std::vector<std::string> required;
   for (const std::string& c : result_columns())
     if (!is_optional_column(c)) required.push_back(c);
-  std::vector<std::map<std::string, std::string>> rows = read_csv_rows(path, required);
+  std::vector<std::map<std::string, std::string>> rows = read_csv_rows(path, required, lines);
   for (auto& row : rows)
     for (const std::string& c : result_columns())
       if (is_optional_column(c)) row.emplace(c, "");  // keeps the file's value when it has the column

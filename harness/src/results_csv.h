@@ -46,7 +46,9 @@ void write_results_csv(const std::string& path, const std::vector<ResultRow>& ro
 // Reads a results CSV into column -> value maps (tests and tools); throws
 // InputError when the header lacks a schema column. Columns appended after
 // the first schema (sah_cost) may be missing, as in files older than them:
-// they read as the empty field, "not applicable".
-std::vector<std::map<std::string, std::string>> read_results_csv(const std::string& path);
+// they read as the empty field, "not applicable". `lines`, when given,
+// receives each row's line number (see read_csv_rows).
+std::vector<std::map<std::string, std::string>> read_results_csv(const std::string& path,
+                                                                 std::vector<std::size_t>* lines = nullptr);
 
 }  // namespace raybench
