@@ -45,7 +45,7 @@ std::string last_line(const std::string& text) {
   return line;
 }
 
-// A pipe's two ends, each closed once, at scope end or by reset.
+// A descriptor, closed once: at scope end or by reset().
 struct Fd {
   int fd = -1;
   ~Fd() { reset(); }

@@ -5,9 +5,10 @@
 // with SIGKILL when the deadline passes, and always reaps it with waitpid.
 //
 // The child is a fork of a process that may be running TBB worker threads:
-// only the forking thread exists in it, so `work` must not use TBB, stdio or
-// any lock another thread may have held at the fork. It may allocate (glibc
-// resets malloc's locks in the child of fork) and write(2) to its descriptor.
+// only the forking thread exists in it, so `work` must not use TBB or any
+// lock another thread may have held at the fork (should a library it calls
+// block on one, the deadline ends the child). It may allocate (glibc resets
+// malloc's locks in the child of fork) and write(2) to its descriptor.
 // The child ends with _exit: it never returns into the caller's code, runs no
 // atexit handlers and flushes no stdio buffers inherited from the parent.
 // `work` may call _exit(0) itself once it has written its answer, to skip
