@@ -33,7 +33,25 @@ struct Scene {
 
 // Loads a mesh file with assimp, or builds a procedural scene when `spec`
 // starts with "proc:" (see procedural.h). Throws InputError naming the file
-// on a missing, unreadable or malformed file, or one without triangles.
+// on a missing, unreadable or malformed file, one without triangles, or one
+// that check_scene_coordinates refuses. assimp runs in a child process with
+// a deadline (RAYBENCH_LOAD_TIMEOUT, see scene_assimp.cpp): a crash or hang
+// of it is such an error too.
 Scene load_scene(const std::string& spec);
+
+// The largest coordinate magnitude a scene's vertices may have. Box surface
+// areas, which every BVH builder and the collapse compute in float, must stay
+// finite: a box within +-B has extents up to 2B and surface area up to
+// 2 * 3 * (2B)^2 = 24 B^2, finite while B <= sqrt(FLT_MAX / 24) = 3.7e18.
+// 1e18 keeps the scene box's area (2.4e37) a factor 14 below FLT_MAX.
+// Coordinates of +-1e19 overflowed the wide BVH's collapse (issue 28).
+inline constexpr float kMaxSceneCoordinate = 1e18f;
+
+// Throws InputError(where, ...) when a vertex of `scene` is not finite or
+// has a coordinate beyond +-kMaxSceneCoordinate; `where` names the file or
+// the manifest's scene. load_scene runs it on what the file holds, and
+// load_suite_scene (suite.h) again after the manifest's scale and offset,
+// on the vertices as they will be traced.
+void check_scene_coordinates(const Scene& scene, const std::string& where);
 
 }  // namespace raybench

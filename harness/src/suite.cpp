@@ -139,6 +139,7 @@ Scene load_suite_scene(const SuiteScene& entry) {
       t.v1 = moved(t.v1, entry.scale, entry.offset);
       t.v2 = moved(t.v2, entry.scale, entry.offset);
     }
+    check_scene_coordinates(scene, "scene '" + entry.name + "' (" + entry.path + " with the manifest's scale and offset)");
   }
   return scene;
 }
