@@ -429,7 +429,7 @@ int run(int argc, char** argv) {
   if (*rays_cmd) {
     const std::size_t count = flag_value("--count", rays_count, rays_setting);
     const std::uint64_t seed = flag_value("--seed", rays_seed, seed_setting);
-    check_outputs({output("--out", rays_out)});
+    check_outputs({output("--out", rays_out)}, {{"--scene", rays_scene, "--scene " + rays_scene}});
     Suite storage;
     const Suite* suite = suite_if_readable(rays_suite, rays_cmd->count("--suite") > 0, storage);
     const RaySetKind kind = parse_rayset_kind(rays_kind);
@@ -446,7 +446,8 @@ int run(int argc, char** argv) {
   if (*trace_cmd) {
     const int threads = flag_value("--threads", trace_threads, threads_setting);
     check_input_file(trace_rays, "ray file (.npy)");
-    check_outputs({output("--out", trace_out)}, {{"--rays", trace_rays, "--rays " + trace_rays}});
+    check_outputs({output("--out", trace_out)},
+                  {{"--rays", trace_rays, "--rays " + trace_rays}, {"--scene", trace_scene, "--scene " + trace_scene}});
     Suite storage;
     const Suite* suite = suite_if_readable(trace_suite, trace_cmd->count("--suite") > 0, storage);
     std::unique_ptr<Backend> backend = make_backend(trace_backend, {threads});

@@ -257,6 +257,14 @@ class Outputs(HardeningTestCase):
         self.assertBadInput(run("trace", "--scene", "proc:sphere", "--rays", rays, "-o", rays),
                             f"--out {rays} is the same file as the input --rays {rays}")
         self.assertEqual(np.load(rays).shape, (1, 8))
+        mesh = self.path("tri.obj")
+        with open(mesh, "w") as f:
+            f.write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+        self.assertBadInput(run("trace", "--scene", mesh, "--rays", rays, "-o", mesh),
+                            f"--out {mesh} is the same file as the input --scene {mesh}")
+        self.assertBadInput(run("rays", "--scene", mesh, "-n", "10", "-o", mesh), "is the same file as the input --scene")
+        with open(mesh) as f:
+            self.assertTrue(f.read().startswith("v 0 0 0"))
 
     def test_an_unwritable_out_is_named_as_given_not_as_an_internal_probe_file(self):
         blocker = self.path("file")
