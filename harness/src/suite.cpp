@@ -43,12 +43,11 @@ class Reader {
     } else if constexpr (std::is_same_v<T, bool>) {
       if (auto v = node->value<bool>()) return *v;
       fail(where + key, "expected true or false");
-    } else if constexpr (std::is_floating_point_v<T>) {
+    } else {
+      // Integers go through settings_rules.h (setting()), never a bare cast.
+      static_assert(std::is_floating_point_v<T>, "an integer setting needs its rule");
       if (auto v = node->value<double>()) return static_cast<T>(*v);
       fail(where + key, "expected a number");
-    } else {
-      if (auto v = node->value<std::int64_t>(); v && *v >= 0) return static_cast<T>(*v);
-      fail(where + key, "expected a non-negative integer");
     }
   }
 
