@@ -118,6 +118,12 @@ void check_outputs(const std::vector<FileArg>& outputs, const std::vector<FileAr
   }
 }
 
+// An output a command cannot do without: '' would fail only when the
+// results are written, after the whole run.
+void check_named(const std::string& flag, const std::string& path) {
+  if (path.empty()) throw InputError(flag, "must name a file, got ''");
+}
+
 // A folder raybench writes into: absent (it is created) or a directory.
 void check_output_folder(const std::string& flag, const std::string& path) {
   std::error_code ec;
@@ -352,6 +358,7 @@ int run(int argc, char** argv) {
     kernel_options.repetitions = flag_value("--reps", kernels_reps, repetitions_setting);
     kernel_options.min_time = flag_value("--min-time", kernels_min_time, min_time_setting);
     kernel_options.pairs = flag_value("--pairs", kernels_pairs, pairs_setting);
+    check_named("--out", kernel_options.out_csv);
     check_outputs({output("--out", kernel_options.out_csv), metadata_of("--out", kernel_options.out_csv),
                    output("--json", kernel_options.out_json)});
     kernel_options.command_line = command_line(argc, argv);
@@ -392,6 +399,8 @@ int run(int argc, char** argv) {
     override_with("--seed", run_seed, seed_setting, &SuiteSettings::seed);
     override_with("--min-time", run_min_time, min_time_setting, &SuiteSettings::min_time);
     override_with("--warmup", run_warmup, warmup_setting, &SuiteSettings::warmup);
+    check_named("--out", run_options.out_csv);
+    if (run_options.rays_dir.empty()) throw InputError("--rays-dir", "must name a folder, got ''");
     check_outputs({output("--out", run_options.out_csv), metadata_of("--out", run_options.out_csv),
                    output("--accuracy", run_options.accuracy_csv),
                    run_options.accuracy_csv.empty() ? FileArg{} : metadata_of("--accuracy", run_options.accuracy_csv)},
@@ -429,6 +438,7 @@ int run(int argc, char** argv) {
   if (*rays_cmd) {
     const std::size_t count = flag_value("--count", rays_count, rays_setting);
     const std::uint64_t seed = flag_value("--seed", rays_seed, seed_setting);
+    check_named("--out", rays_out);
     check_outputs({output("--out", rays_out)}, {{"--scene", rays_scene, "--scene " + rays_scene}});
     Suite storage;
     const Suite* suite = suite_if_readable(rays_suite, rays_cmd->count("--suite") > 0, storage);
@@ -446,6 +456,7 @@ int run(int argc, char** argv) {
   if (*trace_cmd) {
     const int threads = flag_value("--threads", trace_threads, threads_setting);
     check_input_file(trace_rays, "ray file (.npy)");
+    check_named("--out", trace_out);
     check_outputs({output("--out", trace_out)},
                   {{"--rays", trace_rays, "--rays " + trace_rays}, {"--scene", trace_scene, "--scene " + trace_scene}});
     Suite storage;

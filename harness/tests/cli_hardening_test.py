@@ -251,6 +251,16 @@ class Outputs(HardeningTestCase):
                 self.assertBadInput(run(*args, "/dev/null"), "/dev/null", "is a character device")
                 self.assertTrue(stat.S_ISCHR(os.stat("/dev/null").st_mode))
 
+    def test_an_empty_output_name_is_refused_before_the_run_not_after(self):
+        for args in (["run", "--scene", "proc:sphere", "--rays", "100", "--rays-dir", self.path("rays"), "--out", ""],
+                     ["run", "--scene", "proc:sphere", "--rays", "100", "--out", self.path("o.csv"), "--rays-dir", ""],
+                     ["rays", "--scene", "proc:sphere", "-n", "10", "-o", ""],
+                     ["kernels", "--json", "", "--out", ""]):
+            with self.subTest(args=args):
+                result = run(*args)
+                self.assertBadInput(result, "must name a")
+                self.assertNotIn("loading", result.stderr)
+
     def test_an_output_is_never_one_of_the_inputs(self):
         rays = self.path("r.npy")
         np.save(rays, np.array([[0, 0, 5, 0, 0, 0, -1, np.inf]], dtype=np.float32))
