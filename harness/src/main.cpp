@@ -285,7 +285,7 @@ int run(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
-    std::cerr << "raybench: error: " << e.what() << " (see 'raybench --help')" << std::endl;
+    std::cerr << "raybench: error: " << raybench::printable(e.what()) << " (see 'raybench --help')" << std::endl;
     return 2;
   }
 
@@ -497,18 +497,20 @@ int run(int argc, char** argv) {
 }  // namespace
 }  // namespace raybench
 
+// Every error is one line (printable: a newline in a user's file or scene
+// name is written as \x0a), so scripts can take the last line of stderr.
 int main(int argc, char** argv) {
   try {
     raybench::record_source_state();  // the sources as built, before a long run
     return raybench::run(argc, argv);
   } catch (const raybench::InputError& e) {
-    std::cerr << "raybench: error: " << e.what() << std::endl;
+    std::cerr << "raybench: error: " << raybench::printable(e.what()) << std::endl;
     return 2;
   } catch (const std::bad_alloc&) {
     std::cerr << "raybench: error: out of memory" << std::endl;
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "raybench: error: " << e.what() << std::endl;
+    std::cerr << "raybench: error: " << raybench::printable(e.what()) << std::endl;
     return 2;
   }
 }

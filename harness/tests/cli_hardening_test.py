@@ -193,6 +193,14 @@ class SceneNames(HardeningTestCase):
         self.assertNothingWritten()
 
 
+class OneLineErrors(HardeningTestCase):
+    def test_a_newline_in_a_users_name_cannot_split_the_error_line(self):
+        mesh = self.path("two\nlines.obj")
+        self.assertBadInput(run("rays", "--scene", mesh, "-o", self.path("r.npy")), "two\\x0alines.obj", "no such file")
+        self.assertBadInput(run("run", "--scene", "proc:sphere", "--backend", "bvh2\nx", "--rays", "100",
+                                "--out", self.path("o.csv"), "--rays-dir", self.path("rays")), "bvh2\\x0ax")
+
+
 class Outputs(HardeningTestCase):
     def run_tiny(self, *args):
         return run("run", "--scene", "proc:sphere", "--rayset", "uniform", "--backend", "bvh2", "--rays", "100",
