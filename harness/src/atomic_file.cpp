@@ -65,7 +65,11 @@ void check_writable(const std::string& path) {
   std::error_code ec;
   const std::string probe = path + ".probe." + std::to_string(::getpid());
   const RemoveOnInterrupt remove_probe(probe);
-  write_file_atomically(probe, [](std::ostream&) {});
+  try {
+    write_file_atomically(probe, [](std::ostream&) {});
+  } catch (const InputError& e) {  // named after the probe: name the user's path
+    throw InputError(path, std::string(e.what()).substr(probe.size() + 2));
+  }
   std::filesystem::remove(probe, ec);
   if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory");
 }

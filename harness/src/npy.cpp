@@ -1,15 +1,18 @@
 #include "npy.h"
 
+#include <charconv>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <regex>
 
 #include <fmt/format.h>
 
 #include "atomic_file.h"
 #include "error.h"
+#include "input_file.h"
 
 namespace raybench {
 namespace {
@@ -22,6 +25,46 @@ struct NpyHeader {
   std::vector<std::size_t> shape;
   std::size_t data_offset = 0;
 };
+
+// The dimensions inside a shape's parentheses: a Python tuple of
+// non-negative integers as numpy writes it ("16, 8", "16,", "16, 8, " or
+// ""), nothing else. Anything else -- a sign, a float, an expression, an
+// empty element -- is refused rather than half-read (std::stoull read
+// "-16" as 16).
+std::vector<std::size_t> parse_shape(const std::string& dims, const std::string& path) {
+  const auto bad = [&](const std::string& why) {
+    return InputError(path, fmt::format("malformed .npy header: 'shape' ({}) is not a tuple of non-negative integers: {}",
+                                        dims, why));
+  };
+  std::vector<std::size_t> shape;
+  std::size_t i = 0;
+  const auto skip_space = [&] {
+    while (i < dims.size() && (dims[i] == ' ' || dims[i] == '\t')) ++i;
+  };
+  skip_space();
+  while (i < dims.size()) {
+    const std::size_t start = i;
+    while (i < dims.size() && dims[i] >= '0' && dims[i] <= '9') ++i;
+    if (i == start) {
+      if (dims[i] == '-') throw bad(fmt::format("dimension {} is negative", shape.size()));
+      throw bad(fmt::format("dimension {} is not an integer", shape.size()));
+    }
+    std::uint64_t d = 0;
+    if (const auto r = std::from_chars(dims.data() + start, dims.data() + i, d); r.ec != std::errc())
+      throw InputError(path, fmt::format(".npy shape dimension {} ({}) is too large", shape.size(),
+                                         dims.substr(start, i - start)));
+    shape.push_back(d);
+    skip_space();
+    if (i == dims.size()) {
+      if (shape.size() != 1) break;  // (16,) needs its comma: (16) is not a tuple
+      throw bad("a 1-element tuple needs a trailing comma");
+    }
+    if (dims[i] != ',') throw bad(fmt::format("unexpected '{}' after dimension {}", dims[i], shape.size() - 1));
+    ++i;
+    skip_space();
+  }
+  return shape;
+}
 
 // Parses the header dictionary, e.g.
 // {'descr': '<f4', 'fortran_order': False, 'shape': (1024, 8), }
@@ -59,10 +102,7 @@ NpyHeader read_header(std::istream& in, const std::string& path) {
   if (!std::regex_search(dict, m, order_re)) throw InputError(path, "malformed .npy header: no 'fortran_order'");
   h.fortran_order = m[1] == "True";
   if (!std::regex_search(dict, m, shape_re)) throw InputError(path, "malformed .npy header: no 'shape'");
-  const std::string dims = m[1];
-  static const std::regex dim_re(R"(\s*(\d+)\s*(,|$))");
-  for (auto it = std::sregex_iterator(dims.begin(), dims.end(), dim_re); it != std::sregex_iterator(); ++it)
-    h.shape.push_back(std::stoull((*it)[1]));
+  h.shape = parse_shape(m[1], path);
   return h;
 }
 
@@ -75,8 +115,8 @@ std::string shape_string(const std::vector<std::size_t>& shape) {
 // Reads a 2-D array of `columns` columns and element type `descr`.
 std::vector<char> read_matrix(const std::string& path, const char* descr, std::size_t element_size,
                               std::size_t columns, const char* what, std::size_t& rows) {
+  check_input_file(path, ".npy file");
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(path, "no such file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "cannot be opened for reading");
   const NpyHeader h = read_header(in, path);
@@ -87,10 +127,15 @@ std::vector<char> read_matrix(const std::string& path, const char* descr, std::s
     throw InputError(path, fmt::format("shape is {}, expected (N, {}) ({})", shape_string(h.shape), columns, what));
   rows = h.shape[0];
   const std::uintmax_t file_size = std::filesystem::file_size(path, ec);
-  const std::uintmax_t expected = h.data_offset + rows * columns * element_size;
-  if (file_size < expected)
-    throw InputError(path, fmt::format("truncated: header promises {} rows ({} bytes) but the file has {} bytes",
-                                       rows, expected, file_size));
+  if (ec) throw InputError(path, "cannot read its size: " + ec.message());
+  // The body's size is checked against the file before anything is
+  // allocated, without overflow: a header may promise any number of rows.
+  const std::uintmax_t row_bytes = columns * element_size;  // columns >= 1: 8 for rays, at most 1024
+  if (rows > (std::numeric_limits<std::uintmax_t>::max() - h.data_offset) / row_bytes ||
+      h.data_offset + rows * row_bytes > file_size)
+    throw InputError(path, fmt::format("truncated: the header promises {} rows of {} bytes, more than the file's {} "
+                                       "bytes hold", rows, row_bytes, file_size));
+  const std::uintmax_t expected = h.data_offset + rows * row_bytes;
   if (file_size > expected)
     throw InputError(path, fmt::format("{} unexpected bytes after the {} rows the header declares",
                                        file_size - expected, rows));
@@ -140,12 +185,13 @@ void write_npy_f64(const std::string& path, std::span<const double> data, std::s
 }
 
 std::vector<double> read_npy_f64(const std::string& path, std::size_t& rows, std::size_t& columns) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(path, "no such file");
+  check_input_file(path, ".npy file");
   std::ifstream in(path, std::ios::binary);
   const NpyHeader h = read_header(in, path);
   if (h.shape.size() != 2) throw InputError(path, "expected a 2-D array");
   columns = h.shape[1];
+  if (columns == 0 || columns > 1024)
+    throw InputError(path, fmt::format("shape is {}: expected 1 to 1024 columns", shape_string(h.shape)));
   const std::vector<char> body = read_matrix(path, "<f8", sizeof(double), columns, "float64", rows);
   std::vector<double> out(rows * columns);
   std::memcpy(out.data(), body.data(), body.size());

@@ -5,12 +5,15 @@
 #include <filesystem>
 #include <limits>
 #include <set>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
 #include "error.h"
+#include "input_file.h"
 #include "procedural.h"
+#include "settings_rules.h"
 
 namespace raybench {
 namespace {
@@ -40,13 +43,33 @@ class Reader {
     } else if constexpr (std::is_same_v<T, bool>) {
       if (auto v = node->value<bool>()) return *v;
       fail(where + key, "expected true or false");
-    } else if constexpr (std::is_floating_point_v<T>) {
+    } else {
+      // Integers go through settings_rules.h (setting()), never a bare cast.
+      static_assert(std::is_floating_point_v<T>, "an integer setting needs its rule");
       if (auto v = node->value<double>()) return static_cast<T>(*v);
       fail(where + key, "expected a number");
-    } else {
-      if (auto v = node->value<std::int64_t>(); v && *v >= 0) return static_cast<T>(*v);
-      fail(where + key, "expected a non-negative integer");
     }
+  }
+
+  // A numeric setting for a rule of settings_rules.h, named by file and key.
+  GivenValue given(const toml::node& node, const std::string& key) const {
+    std::ostringstream text;
+    node.visit([&](const auto& n) { text << n; });
+    std::optional<std::int64_t> integer;
+    std::optional<double> number;
+    if (const auto* i = node.as_integer()) {
+      integer = i->get();
+      number = static_cast<double>(*integer);
+    } else if (const auto* f = node.as_floating_point()) {
+      number = f->get();
+    }
+    return GivenValue::from_manifest(path_, key, text.str(), integer, number);
+  }
+
+  // Applies `rule` to table[key] when present; otherwise keeps `value`.
+  template <typename T, typename Rule>
+  void setting(const toml::table& table, const std::string& where, const char* key, Rule rule, T& value) const {
+    if (const toml::node* node = table.get(key)) value = rule(given(*node, where + key));
   }
 
   std::vector<std::string> strings(const toml::table& table, const std::string& where, const char* key,
@@ -64,6 +87,23 @@ class Reader {
     return out;
   }
 
+  // A point (camera position and target, light, ball centre): finite, and
+  // within the coordinates every backend can trace (kLargestTraceableCoordinate,
+  // Embree's range); rays from or towards a point beyond it are all misses.
+  Vec3f point(const toml::node& node, const std::string& key) const {
+    const Vec3f v = vec3(node, key);
+    check_point(v, key, "");
+    return v;
+  }
+
+  void check_point(const Vec3f& v, const std::string& key, const char* context) const {
+    for (int i = 0; i < 3; ++i)
+      if (!(std::fabs(v[i]) <= kLargestTraceableCoordinate))
+        fail(key, fmt::format("{}expected [x, y, z] finite coordinates within +-{:g}, got [{}, {}, {}]", context,
+                              kLargestTraceableCoordinate, v.x, v.y, v.z));
+  }
+
+  // [x, y, z]: numbers that are finite as float.
   Vec3f vec3(const toml::node& node, const std::string& key) const {
     const toml::array* array = node.as_array();
     if (!array || array->size() != 3) fail(key, "expected [x, y, z]");
@@ -72,6 +112,7 @@ class Reader {
       auto c = (*array)[static_cast<std::size_t>(i)].value<double>();
       if (!c) fail(key, "expected [x, y, z] numbers");
       v[i] = static_cast<float>(*c);
+      if (!std::isfinite(v[i])) fail(key, fmt::format("expected [x, y, z] finite numbers, got {}", *c));
     }
     return v;
   }
@@ -94,12 +135,54 @@ class Reader {
     check_keys(*t, key, {"position", "look_at", "up", "fov"});
     Camera c;
     if (!t->get("position") || !t->get("look_at")) fail(key, "needs position and look_at");
-    c.position = vec3(*t->get("position"), key + ".position");
-    c.look_at = vec3(*t->get("look_at"), key + ".look_at");
+    c.position = point(*t->get("position"), key + ".position");
+    c.look_at = point(*t->get("look_at"), key + ".look_at");
     if (t->get("up")) c.up = vec3(*t->get("up"), key + ".up");
     c.fov_degrees = get<float>(*t, key + ".", "fov", c.fov_degrees);
     if (!(c.fov_degrees > 0.0f && c.fov_degrees < 180.0f)) fail(key + ".fov", "must be in (0, 180) degrees");
+    check_view(c, key, "");
     return c;
+  }
+
+  // A camera defines a view only when it looks somewhere (look_at is not its
+  // position) and `up` is not along the view direction: otherwise the basis
+  // of camera_ray (rayset.cpp, in double) has a zero vector and every ray is NaN.
+  void check_view(const Camera& c, const std::string& key, const char* context) const {
+    const double f[3] = {double(c.look_at.x) - c.position.x, double(c.look_at.y) - c.position.y,
+                         double(c.look_at.z) - c.position.z};
+    const double u[3] = {c.up.x, c.up.y, c.up.z};
+    const double f_len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    const double u_len = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    if (f_len == 0.0)
+      fail(key + ".look_at", fmt::format("{}is the camera's position [{}, {}, {}]: the camera looks nowhere", context,
+                                         c.position.x, c.position.y, c.position.z));
+    if (u_len == 0.0) fail(key + ".up", "must not be [0, 0, 0]");
+    const double cross[3] = {f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2], f[0] * u[1] - f[1] * u[0]};
+    const double sine = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]) / (f_len * u_len);
+    // sin 1e-6: up within a microradian of the view direction.
+    if (!(sine > 1e-6))
+      fail(key + ".up", fmt::format("{}[{}, {}, {}] is parallel to the view direction (look_at - position): "
+                                    "up must point across it", context, c.up.x, c.up.y, c.up.z));
+  }
+
+  // What scale and offset made of the camera, light and ball: still a view,
+  // still within range (a large scale can push them out; float rounding at a
+  // large offset can merge a camera with its target).
+  void check_moved(const SuiteScene& scene, const std::string& key) const {
+    if (!scene.transformed()) return;
+    const std::string context = fmt::format("at scale {:g} and offset [{:g}, {:g}, {:g}] (scene '{}'): ", scene.scale,
+                                            scene.offset[0], scene.offset[1], scene.offset[2], scene.name);
+    if (scene.camera) {
+      check_point(scene.camera->position, key + ".camera.position", context.c_str());
+      check_point(scene.camera->look_at, key + ".camera.look_at", context.c_str());
+      check_view(*scene.camera, key + ".camera", context.c_str());
+    }
+    if (scene.light) check_point(*scene.light, key + ".light", context.c_str());
+    if (scene.inside) {
+      check_point(scene.inside->center, key + ".inside.center", context.c_str());
+      if (!(scene.inside->radius > 0.0f && std::isfinite(scene.inside->radius)))
+        fail(key + ".inside.radius", context + "must be a finite number > 0");
+    }
   }
 
  private:
@@ -158,8 +241,7 @@ const SuiteScene* Suite::find(const std::string& name) const {
 
 Suite load_suite(const std::string& path) {
   namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw InputError(path, "no such suite manifest");
+  check_input_file(path, "suite manifest");
   toml::table root;
   try {
     root = toml::parse_file(path);
@@ -176,7 +258,7 @@ Suite load_suite(const std::string& path) {
     if (!t) r.fail("defaults", "expected a table");
     r.check_keys(*t, "defaults", {"rays", "raysets", "backends", "threads", "repetitions", "build_repetitions", "seed",
                                   "min_time", "warmup"});
-    s.rays = r.get<std::size_t>(*t, "defaults.", "rays", s.rays);
+    r.setting(*t, "defaults.", "rays", rays_setting, s.rays);
     s.raysets = r.strings(*t, "defaults.", "raysets", s.raysets);
     for (const std::string& k : s.raysets) {
       try {
@@ -190,17 +272,13 @@ Suite load_suite(const std::string& path) {
       const toml::array* a = th->as_array();
       if (!a || a->empty()) r.fail("defaults.threads", "expected an array of thread counts, e.g. [1, 2]");
       s.threads.clear();
-      for (const toml::node& e : *a) {
-        auto v = e.value<std::int64_t>();
-        if (!v || *v < 1) r.fail("defaults.threads", "thread counts must be integers >= 1");
-        s.threads.push_back(static_cast<int>(*v));
-      }
+      for (const toml::node& e : *a) s.threads.push_back(threads_setting(r.given(e, "defaults.threads")));
     }
-    s.repetitions = r.get<int>(*t, "defaults.", "repetitions", s.repetitions);
-    s.build_repetitions = r.get<int>(*t, "defaults.", "build_repetitions", s.build_repetitions);
-    s.seed = r.get<std::uint64_t>(*t, "defaults.", "seed", s.seed);
-    s.min_time = r.get<double>(*t, "defaults.", "min_time", s.min_time);
-    s.warmup = r.get<double>(*t, "defaults.", "warmup", s.warmup);
+    r.setting(*t, "defaults.", "repetitions", repetitions_setting, s.repetitions);
+    r.setting(*t, "defaults.", "build_repetitions", build_repetitions_setting, s.build_repetitions);
+    r.setting(*t, "defaults.", "seed", seed_setting, s.seed);
+    r.setting(*t, "defaults.", "min_time", min_time_setting, s.min_time);
+    r.setting(*t, "defaults.", "warmup", warmup_setting, s.warmup);
   }
   const fs::path base = fs::path(path).parent_path();
   if (const toml::node* scenes = root.get("scene")) {
@@ -216,19 +294,21 @@ Suite load_suite(const std::string& path) {
       scene.name = r.get<std::string>(*t, key + ".", "name", "");
       scene.path = r.get<std::string>(*t, key + ".", "path", "");
       if (scene.name.empty() || scene.path.empty()) r.fail(key, "needs a name and a path");
+      if (const std::string problem = scene_name_problem(scene.name); !problem.empty()) r.fail(key + ".name", problem);
       if (suite.find(scene.name) && !t->get("sweep")) r.fail(key + ".name", "duplicate scene name '" + scene.name + "'");
       if (scene.path.rfind(kProceduralPrefix, 0) != 0 && fs::path(scene.path).is_relative())
         scene.path = (base / scene.path).lexically_normal().string();
       scene.optional = r.get<bool>(*t, key + ".", "optional", false);
       if (const toml::node* c = t->get("camera")) scene.camera = r.camera(*c, key + ".camera");
-      if (const toml::node* l = t->get("light")) scene.light = r.vec3(*l, key + ".light");
+      if (const toml::node* l = t->get("light")) scene.light = r.point(*l, key + ".light");
       if (const toml::node* in = t->get("inside")) {
         const toml::table* b = in->as_table();
         if (!b || !b->get("center")) r.fail(key + ".inside", "expected { center = [x, y, z], radius = r }");
         r.check_keys(*b, key + ".inside", {"center", "radius"});
-        scene.inside = InsideBall{r.vec3(*b->get("center"), key + ".inside.center"),
+        scene.inside = InsideBall{r.point(*b->get("center"), key + ".inside.center"),
                                   r.get<float>(*b, key + ".inside.", "radius", 0.0f)};
-        if (!(scene.inside->radius > 0.0f)) r.fail(key + ".inside.radius", "must be > 0");
+        if (!(scene.inside->radius > 0.0f && std::isfinite(scene.inside->radius)))
+          r.fail(key + ".inside.radius", "must be a finite number > 0");
       }
       scene.raysets = r.strings(*t, key + ".", "raysets", {});
       for (const std::string& k : scene.raysets) {
@@ -244,6 +324,7 @@ Suite load_suite(const std::string& path) {
       const toml::node* sweep = t->get("sweep");
       if (!sweep) {
         move_entry(scene);
+        r.check_moved(scene, key);
         suite.scenes.push_back(std::move(scene));
         continue;
       }
@@ -263,9 +344,11 @@ Suite load_suite(const std::string& path) {
         for (const toml::node& o : *oa) offsets.push_back(r.vec3d(o, key + ".sweep.offsets"));
       }
       const double max_quantisation = r.get<double>(*w, key + ".sweep.", "max_quantisation", 1e-3);
+      if (!(max_quantisation > 0.0 && std::isfinite(max_quantisation)))
+        r.fail(key + ".sweep.max_quantisation", "must be a finite number > 0");
       for (const toml::node& sn : *scales) {
         const auto sv = sn.value<double>();
-        if (!sv || !(*sv > 0.0)) r.fail(key + ".sweep.scales", "expected positive numbers");
+        if (!sv || !(*sv > 0.0 && std::isfinite(*sv))) r.fail(key + ".sweep.scales", "expected finite positive numbers");
         for (const auto& o : offsets) {
           const double far = std::max({std::fabs(o[0]), std::fabs(o[1]), std::fabs(o[2])});
           const float f = static_cast<float>(far);
@@ -277,6 +360,7 @@ Suite load_suite(const std::string& path) {
           if (far > 0.0) copy.name += fmt::format("@o{:g}_{:g}_{:g}", o[0], o[1], o[2]);
           if (suite.find(copy.name)) r.fail(key + ".name", "duplicate scene name '" + copy.name + "'");
           move_entry(copy);
+          r.check_moved(copy, key);
           suite.scenes.push_back(std::move(copy));
         }
       }

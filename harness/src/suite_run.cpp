@@ -28,6 +28,7 @@
 #include "rayset.h"
 #include "referee/referee.h"
 #include "scene.h"
+#include "settings_rules.h"
 #include "trace.h"
 
 namespace raybench {
@@ -53,6 +54,7 @@ struct RaySet {
 // each secondary ray starts; they are not stored in the ray file.
 std::vector<Ray> obtain_rays(const RayGenerator& generator, const Scene& scene, const RaySetSpec& spec,
                              const std::string& rays_dir, std::vector<std::int32_t>* sources = nullptr) {
+  if (const std::string problem = scene_name_problem(scene.name); !problem.empty()) throw InputError(printable(scene.name), problem);
   const std::string path = fmt::format("{}/{}.{}.n{}.{:016x}.npy", rays_dir, scene.name, to_string(spec.kind),
                                        spec.count, generator.key(spec));
   std::error_code ec;
@@ -340,7 +342,8 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
   if (names.empty()) {
     for (const SuiteScene& s : options.suite.scenes) {
       if (s.available()) names.push_back(s.name);
-      else progress(fmt::format("skipping scene '{}': {} not found{}", s.name, s.path, s.optional ? "" : " (not optional!)"));
+      else if (!s.optional) throw InputError(options.suite.path, fmt::format("scene '{}': {} not found (add optional = true to skip it when absent)", s.name, s.path));
+      else progress(fmt::format("skipping scene '{}': {} not found", s.name, s.path));
     }
     if (names.empty()) throw InputError(options.suite.path, "no scene of the suite is available");
   }
