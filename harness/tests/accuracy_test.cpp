@@ -12,14 +12,14 @@
 
 #include "accuracy/accuracy_csv.h"
 #include "accuracy/judge.h"
-#include "backend.h"
+#include "backends/backend.h"
 #include "build_info.h"
-#include "rayset.h"
+#include "rays/rayset.h"
 #include "referee/referee.h"
-#include "suite.h"
-#include "suite_run.h"
+#include "suite/suite.h"
+#include "suite/suite_run.h"
 #include "test_util.h"
-#include "trace.h"
+#include "measure/trace.h"
 
 namespace raybench {
 namespace {

@@ -1,6 +1,6 @@
 // Specification of atomic_file.h: a result is either whole at its path or
 // not there, and no temporary file outlives the write, on any path.
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 
 #include <fstream>
 #include <sstream>

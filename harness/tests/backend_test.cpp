@@ -1,6 +1,6 @@
-// Specification of the backend interface (harness/src/backend.h), for every
+// Specification of the backend interface (harness/src/backends/backend.h), for every
 // backend alike: known answers, untraceable rays, threads, and names.
-#include "backend.h"
+#include "backends/backend.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,11 +9,11 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
-#include "error.h"
-#include "rayset.h"
-#include "scene.h"
+#include "io/error.h"
+#include "rays/rayset.h"
+#include "scene/scene.h"
 #include "test_util.h"
-#include "trace.h"
+#include "measure/trace.h"
 
 namespace raybench {
 namespace {

@@ -1,9 +1,9 @@
-// Specification of what compare and gate read (harness/src/compare.h): a
+// Specification of what compare and gate read (harness/src/results/compare.h): a
 // value that cannot be read as a number is bad input naming the file, row and
 // column; a baseline without the reference backend is bad input, a current
 // run without it a failure; partial files are named; rows are matched
 // through hash maps, so 100,000 rows compare (ctest's TIMEOUT guards it).
-#include "compare.h"
+#include "results/compare.h"
 
 #include <map>
 #include <string>
@@ -12,7 +12,7 @@
 
 #include <fmt/format.h>
 
-#include "results_csv.h"
+#include "results/results_csv.h"
 #include "test_util.h"
 
 namespace raybench {

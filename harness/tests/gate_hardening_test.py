@@ -1,7 +1,7 @@
 """`raybench compare` and `raybench gate` on the inputs of issue 28: neither passes on what it
 cannot read as numbers. A file that cannot be read as results exits 2 with one line naming the
 file, the row and the column; what the current run's code could have caused is a FAIL line
-(exit 1) naming the row. The rule is written down in harness/src/compare.h.
+(exit 1) naming the row. The rule is written down in harness/src/results/compare.h.
 
 Run through ctest (harness/tests/CMakeLists.txt sets RAYBENCH).
 """
@@ -13,7 +13,7 @@ import unittest
 
 RAYBENCH = os.environ["RAYBENCH"]
 
-# The results schema (harness/src/results_csv.cpp), in file order.
+# The results schema (harness/src/results/results_csv.cpp), in file order.
 COLUMNS = ["scene", "triangles", "rayset", "query", "rays", "backend", "threads", "build_ms", "build_ms_min",
            "build_ms_max", "memory_bytes", "mrays_s", "mrays_s_min", "mrays_s_max", "reps", "mrays_s_samples",
            "ratio_to_embree", "hit_rate", "agree_hit", "agree_prim", "prim_ties", "t_relerr_max", "t_relerr_p999",

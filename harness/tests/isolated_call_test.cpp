@@ -1,6 +1,6 @@
 // Specification of isolated_call.h: work in a child process whose crash,
 // failure or hang is reported, never suffered, and which is always reaped.
-#include "isolated_call.h"
+#include "scene/isolated_call.h"
 
 #include <cerrno>
 #include <csignal>

@@ -1,9 +1,9 @@
-// Specification of the Mann–Whitney U test (harness/src/mann_whitney.h):
+// Specification of the Mann–Whitney U test (harness/src/results/mann_whitney.h):
 // exact p-values counted by hand from the C(n1+n2, n1) equally likely splits,
 // and the normal approximation beyond, against values worked out apart from
 // raybench (the formulas below, and an enumeration in Python's exact
 // fractions for 28 vs 28).
-#include "mann_whitney.h"
+#include "results/mann_whitney.h"
 
 #include <cmath>
 #include <stdexcept>

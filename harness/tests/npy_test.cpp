@@ -1,5 +1,5 @@
-// Specification of the .npy reader and writer (harness/src/npy.h).
-#include "npy.h"
+// Specification of the .npy reader and writer (harness/src/io/npy.h).
+#include "io/npy.h"
 
 #include <cstring>
 #include <fstream>
@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 #include <sys/stat.h>
 
-#include "error.h"
+#include "io/error.h"
 #include "test_util.h"
 
 namespace raybench {

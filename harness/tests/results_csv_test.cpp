@@ -1,6 +1,6 @@
-// Specification of the results CSV (harness/src/results_csv.h): the schema
+// Specification of the results CSV (harness/src/results/results_csv.h): the schema
 // the README documents and later tools (compare, gate) read.
-#include "results_csv.h"
+#include "results/results_csv.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -8,8 +8,8 @@
 #include <fstream>
 #include <map>
 
-#include "error.h"
-#include "metadata.h"
+#include "io/error.h"
+#include "results/metadata.h"
 #include "test_util.h"
 
 namespace raybench {

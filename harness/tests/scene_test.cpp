@@ -1,6 +1,6 @@
-// Specification of scene loading (harness/src/scene.h): what a viewer would
+// Specification of scene loading (harness/src/scene/scene.h): what a viewer would
 // show, every triangle of the file kept, one documented order.
-#include "scene.h"
+#include "scene/scene.h"
 
 #include <cstdlib>
 #include <map>
@@ -8,10 +8,10 @@
 
 #include <sys/stat.h>
 
-#include "error.h"
-#include "ply_precheck.h"
-#include "procedural.h"
-#include "suite.h"
+#include "io/error.h"
+#include "scene/ply_precheck.h"
+#include "scene/procedural.h"
+#include "suite/suite.h"
 #include "test_util.h"
 
 namespace raybench {

@@ -1,5 +1,5 @@
-// Specification of suite manifests (harness/src/suite.h).
-#include "suite.h"
+// Specification of suite manifests (harness/src/suite/suite.h).
+#include "suite/suite.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -8,8 +8,8 @@
 #include <sys/stat.h>
 
 #include "build_info.h"
-#include "error.h"
-#include "settings_rules.h"
+#include "io/error.h"
+#include "suite/settings_rules.h"
 #include "test_util.h"
 
 namespace raybench {

@@ -18,7 +18,7 @@
 
 #include "backends/backend_families.h"
 #include "backends/bvh_options.h"
-#include "error.h"
+#include "io/error.h"
 #include "raybench/bvh/bvh2_builders.h"
 #include "raybench/bvh/bvh2_traverse.h"
 #include "raybench/prim/aabb_slab_robust.h"

@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "error.h"
+#include "io/error.h"
 #include "raybench/bvh/bvh2_reinsertion.h"
 
 namespace raybench {

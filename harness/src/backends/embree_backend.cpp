@@ -10,7 +10,7 @@
 #include <fmt/format.h>
 
 #include "backends/backend_families.h"
-#include "error.h"
+#include "io/error.h"
 
 namespace raybench {
 namespace {
