@@ -9,12 +9,12 @@ import glob
 import os
 import signal
 import subprocess
-import tempfile
 import time
 import tomllib
 import unittest
 
-RAYBENCH = os.environ["RAYBENCH"]
+import cli_testing
+from cli_testing import RAYBENCH, CliTestCase
 
 # A closed cube, 12 triangles: the run's third scene, a mesh file.
 CUBE_OBJ = """v -1 -1 -1
@@ -42,7 +42,7 @@ SCENES = ["sphere", "terrain", "cube"]
 
 
 def run(*args):
-    return subprocess.run([RAYBENCH, *args], capture_output=True, text=True, timeout=600)
+    return cli_testing.run(*args, timeout=600)
 
 
 def read_rows(path):
@@ -55,18 +55,11 @@ def read_meta(csv_path):
         return tomllib.load(f)
 
 
-class SurviveTestCase(unittest.TestCase):
+class SurviveTestCase(CliTestCase):
     def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory()
-        self.dir = self.tmp.name
+        super().setUp()
         with open(self.path("cube.obj"), "w") as f:
             f.write(CUBE_OBJ)
-
-    def tearDown(self):
-        self.tmp.cleanup()
-
-    def path(self, *names):
-        return os.path.join(self.dir, *names)
 
     def write_suite(self, repetitions, min_time=0.01):
         """Three small scenes; with 25 repetitions of 0.04 s each takes seconds, so a signal lands mid-run."""
