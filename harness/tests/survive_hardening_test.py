@@ -72,6 +72,21 @@ class SurviveTestCase(CliTestCase):
                     '[[scene]]\nname = "cube"\npath = "cube.obj"\n')
         return suite
 
+    def signal_when(self, process, ready, sig, what):
+        """Sends `sig` to `process` once ready() holds (polled; at most 300 s) and returns its exit status."""
+        try:
+            deadline = time.monotonic() + 300
+            while not ready():
+                self.assertIsNone(process.poll(), f"the process ended before {what}")
+                self.assertLess(time.monotonic(), deadline, f"not {what} after 300 s")
+                time.sleep(0.02)
+            process.send_signal(sig)
+            return process.wait(timeout=60)
+        finally:
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+
     def assertNoTemporaryFiles(self):
         left = [p for pattern in ("*.tmp.*", "*.probe.*", "*.tmp.gbench")
                 for p in glob.glob(os.path.join(self.dir, "**", pattern), recursive=True)]
@@ -98,18 +113,8 @@ class Signals(SurviveTestCase):
         with open(self.path("stderr.txt"), "w") as err, open(self.path("stdout.txt"), "w") as stdout:
             process = subprocess.Popen([RAYBENCH, "run", "--suite", self.write_suite(repetitions=25, min_time=0.04), "--out", out,
                                         "--rays-dir", self.path("rays")], stdout=stdout, stderr=err)
-            try:
-                deadline = time.monotonic() + 300
-                while not (os.path.exists(out) and read_rows(out)):
-                    self.assertIsNone(process.poll(), "the run ended before its first scene's rows were written")
-                    self.assertLess(time.monotonic(), deadline, "no rows written after 300 s")
-                    time.sleep(0.02)
-                process.send_signal(sig)
-                returncode = process.wait(timeout=60)
-            finally:
-                if process.poll() is None:
-                    process.kill()
-                    process.wait()
+            returncode = self.signal_when(process, lambda: os.path.exists(out) and read_rows(out), sig,
+                                          "the first scene's rows written")
         with open(self.path("stderr.txt")) as f:
             return out, returncode, f.read().strip().splitlines()
 
@@ -199,18 +204,8 @@ class KernelBenchmarkTemporaryFiles(SurviveTestCase):
         with open(self.path("stderr.txt"), "w") as err:
             process = subprocess.Popen([RAYBENCH, "kernels", "--reps", "1000", "--min-time", "0.01", "--pairs", "64",
                                         "--out", self.path("k.csv"), "--json", js], stdout=subprocess.DEVNULL, stderr=err)
-            try:
-                deadline = time.monotonic() + 300
-                while not os.path.exists(js + ".tmp.gbench"):  # Google Benchmark has opened its output
-                    self.assertIsNone(process.poll(), "kernels ended before timing")
-                    self.assertLess(time.monotonic(), deadline)
-                    time.sleep(0.02)
-                process.send_signal(signal.SIGTERM)
-                returncode = process.wait(timeout=60)
-            finally:
-                if process.poll() is None:
-                    process.kill()
-                    process.wait()
+            returncode = self.signal_when(process, lambda: os.path.exists(js + ".tmp.gbench"), signal.SIGTERM,
+                                          "Google Benchmark's output opened")
         with open(self.path("stderr.txt")) as f:
             last = f.read().strip().splitlines()[-1]
         self.assertEqual(returncode, 143, last)
