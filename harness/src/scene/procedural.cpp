@@ -1,3 +1,7 @@
+// The procedural scenes "proc:<name>" (scene/procedural.h): made in double
+// from closed-form shapes and rounded to float once, so they are the same
+// triangles on every machine. The extreme-case scenes follow the catalogue
+// ../shared/EXTREMES.md (its case numbers G.. are given where they are made).
 #include "scene/procedural.h"
 
 #include <cmath>
