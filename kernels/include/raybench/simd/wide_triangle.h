@@ -5,7 +5,7 @@
 // scalar test, over triangles stored structure-of-arrays, as wide BVH leaves
 // store them. AVX2 (8 lanes) or SSE with FMA (4 lanes) when the
 // compiler targets AVX2, else a scalar loop with the same interface.
-// Möller & Trumbore, "Fast, Minimum Storage Ray-Triangle Intersection",
+// Möller & Trumbore, "Fast, Minimum Storage Ray/Triangle Intersection",
 // JGT 2(1), 1997.
 // Guarantee: each lane answers as the scalar test (not watertight: a ray
 // through a shared edge can miss both triangles); unused lanes hold NaN and
