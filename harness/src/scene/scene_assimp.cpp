@@ -10,8 +10,8 @@
 // The deadline is RAYBENCH_LOAD_TIMEOUT seconds (any number in (0, 86400],
 // e.g. 0.5), 120 by default: room for any real mesh (a 28M-triangle one
 // would take about 20 s), and a file that hangs assimp costs two minutes,
-// not forever. measured: docs/notes/harness-measurement.md (which also says
-// that the isolation's cost in load time is not recorded).
+// not forever. measured: docs/notes/harness-measurement.md; what the
+// isolation costs in load time: docs/reliability.md.
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
