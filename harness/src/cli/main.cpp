@@ -159,7 +159,8 @@ int run(int argc, char** argv) {
   CLI::App* run_cmd = app.add_subcommand("run", "Run a benchmark suite: every scene x ray set x backend x thread count");
   run_cmd->add_option("--suite", suite_path, "Suite manifest (TOML)")->capture_default_str();
   run_cmd->add_option("--scene,-s", run_options.scenes,
-                      "Scenes to run: names from the suite, mesh paths, or proc:<name> (default: every available suite scene)")
+                      "Scenes to run: names from the suite, mesh paths, proc:<name>, or NAME=PATH to name a mesh (default: every "
+                      "available suite scene)")
       ->delimiter(',');
   run_cmd->add_option("--rayset,-r", run_raysets, fmt::format("Ray sets: {} (default: the suite's)", fmt::join(rayset_kind_names(), ", ")))
       ->delimiter(',');
