@@ -60,7 +60,7 @@ def main(argv):
     print(f"{out}: {hit:.1%} of primary rays hit")
     if hit < MIN_CAMERA_COVERAGE:
         print(f"warning: the camera sees little of the scene (a run warns below {MIN_CAMERA_COVERAGE:.0%}): "
-              "set camera = { position = [...], look_at = [...] } for it in the manifest, inside the bounds above")
+              "set camera = { position = [...], look_at = [...] } for it in the manifest, look_at inside the bounds above")
     return 0
 
 
