@@ -11,7 +11,8 @@ import subprocess
 import sys
 import unittest
 
-from cli_test import RAYBENCH, WUSON, CliTestCase, run
+from cli_test import WUSON
+from cli_testing import RAYBENCH, CliTestCase, run
 
 SCRIPTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts")
 QUICK = ["--reps", "1", "--build-reps", "1", "--min-time", "0.01", "--warmup", "0"]
