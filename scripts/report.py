@@ -10,7 +10,9 @@ Writes DIR/report.md (default DIR: <dir>/<stem>-report/ of RESULTS.csv, or of th
 - ratio-<rayset>[-t<threads>].png: each non-Embree backend's ratio_to_embree per scene;
 - pareto-<scene>[-t<threads>].png, only without --accuracy: speed versus 1 - agree_hit, which
   is disagreement with Embree, not error against a ground truth (on must-hit ray sets, which
-  have a `leaks` count, leaks / rays, which is).
+  have a `leaks` count, leaks / rays, which is). Ray sets on which every backend sits at 0 are
+  left out (all points on one vertical line); the report says, in one line, that no accuracy
+  file was given and how to make one.
 
 From each --accuracy file (results/accuracy.csv, results/accuracy-kernels.csv; the schema is
 harness/src/accuracy/accuracy_csv.h; every row is one thread; error = false_miss + false_hit +
@@ -956,10 +958,14 @@ def pareto_plots(groups, raysets, colors, triangles, used):
     plots = []
     for scene in scenes:
         for threads in all_threads:
-            panels = [(rs, groups[(scene, rs, threads)]) for rs in raysets
-                      if (scene, rs, threads) in groups]
+            # A panel where every backend sits at error 0 says nothing the throughput plot
+            # does not: left out, and named in the sentence.
+            present = [rs for rs in raysets if (scene, rs, threads) in groups]
+            panels = [(rs, groups[(scene, rs, threads)]) for rs in present
+                      if any(p["error"] > 0 for p in groups[(scene, rs, threads)])]
             if not panels:
                 continue
+            left_out = [rs for rs in present if rs not in dict(panels)]
             kinds = {p["kind"] for _, points in panels for p in points}
             suffix = f"-t{threads}" if len(all_threads) > 1 and threads is not None else ""
             filename = unique_name(f"pareto-{safe_name(scene)}{suffix}", used)
@@ -968,7 +974,9 @@ def pareto_plots(groups, raysets, colors, triangles, used):
             title = (f"Speed versus error: {scene}" + (f" ({tris:,.0f} triangles)" if tris else "")
                      + (f", {thread_words(threads)}" if suffix else ""))
             notes = [ERROR_KINDS[k][1] for k in ERROR_KINDS if k in kinds]
-            plots.append(Plot("Speed versus error", heading, pareto_sentence(kinds), filename,
+            sentence = pareto_sentence(kinds) + (
+                " Not plotted, every backend at 0: " + ", ".join(left_out) + "." if left_out else "")
+            plots.append(Plot("Speed versus error", heading, sentence, filename,
                               lambda path, p=panels, t=title, n=notes: plot_pareto(
                                   path, p, colors, t, n)))
     return plots
@@ -1361,35 +1369,45 @@ def run_section(meta, csv_path, rows):
 
 TABLE_HEADER = ["scene", "backend", "threads", "Mrays/s [min\u2013max]", "\u00d7 Embree",
                 "hit rate", "agree_hit", "agree_prim", "build ms", "MiB"]
+# Columns a table has only when its rows fill them (older CSVs lack some; shadow rays have no
+# triangle, so no ties and no t): (CSV column, header, format).
+OPTIONAL_COLUMNS = [
+    ("prim_ties", "ties", lambda v: f"{v:,.0f}"),
+    ("t_relerr_max", "t relerr max", fmt_short),
+    ("t_relerr_p999", "t relerr p99.9", fmt_short),
+    ("leaks", "leaks", lambda v: f"{v:,.0f}"),
+]
 
 
-def table_row(row, with_leaks):
+def table_row(row, optional):
     cells = [md_escape(row["scene"]), md_escape(row["backend"]), str(row["threads"]),
              fmt_throughput(row), fmt_sig(row["ratio_to_embree"]), fmt_percent(row["hit_rate"]),
              fmt_fraction(row["agree_hit"]), fmt_fraction(row["agree_prim"]),
              fmt_sig(row.get("build_ms")), fmt_mib(row.get("memory_bytes"))]
-    if with_leaks:
-        cells.append(DASH if row.get("leaks") is None else f"{row['leaks']:,.0f}")
+    for column, _, fmt in optional:
+        cells.append(DASH if row.get(column) is None else fmt(row[column]))
     return cells
 
 
 def tables_section(rows, scenes, backends, raysets):
     lines = ["## Tables", "",
              f"Empty cells ({DASH}) are not applicable: occlusion queries report no triangle, "
-             "so shadow rays have no agree_prim. Hit rate is the fraction of rays the backend "
-             "reports hit (occluded for shadow rays); leaks, on must-hit ray sets only, counts "
-             "the rays it lets through a closed mesh.", ""]
+             "so shadow rays have no agree_prim and no t error. Hit rate is the fraction of rays "
+             "the backend reports hit (occluded for shadow rays). Where the CSV has them: ties "
+             "counts the rays both hit on which another triangle lies at the same t (a differing "
+             "triangle there is no disagreement); t relerr max and p99.9 are the largest and the "
+             "99.9th percentile of |t \u2212 t_Embree| / |t_Embree| over the rays both hit; leaks, "
+             "on must-hit ray sets only, counts the rays a backend lets through a closed mesh.", ""]
     for rayset in raysets:
         subset = sorted((r for r in rows if r["rayset"] == rayset),
                         key=lambda r: (scenes.index(r["scene"]), r["threads"],
                                        backends.index(r["backend"])))
-        # Must-hit ray sets count the rays a backend lets through a closed mesh.
-        with_leaks = any(r.get("leaks") is not None for r in subset)
-        header = TABLE_HEADER + (["leaks"] if with_leaks else [])
+        optional = [c for c in OPTIONAL_COLUMNS if any(r.get(c[0]) is not None for r in subset)]
+        header = TABLE_HEADER + [name for _, name, _ in optional]
         lines += [f"### {rayset_caption(rows, rayset)}", "",
                   "| " + " | ".join(header) + " |",
                   "|" + "|".join("---:" if i >= 3 else "---" for i in range(len(header))) + "|"]
-        lines += ["| " + " | ".join(table_row(r, with_leaks)) + " |" for r in subset]
+        lines += ["| " + " | ".join(table_row(r, optional)) + " |" for r in subset]
         lines.append("")
     return lines
 
@@ -1403,6 +1421,18 @@ def plots_section(plots, intro):
         for p in (p for p in plots if p.section == section):
             lines += [f"### {p.heading}", "", p.sentence, "", f"![{p.heading}]({p.filename})", ""]
     return lines
+
+
+# Without --accuracy there is no error against ground truth: the report says so, and how to
+# get one, in the speed-versus-error section, whether or not any panel is left to draw.
+NO_ACCURACY_LINE = ("**No accuracy file given, so no error rates against ground truth.** Make "
+                    "one with `raybench run ... --accuracy accuracy.csv` (every ray judged by "
+                    "the exact referee; `scripts/accuracy` runs the whole accuracy suite) and "
+                    "pass it as `scripts/report RESULTS.csv --accuracy accuracy.csv`. Ray sets "
+                    "on which every backend agrees with Embree are not plotted here.")
+FALLBACK_ERROR = ("Below, the error is 1 \u2212 agree_hit, disagreement with Embree, not an "
+                  "error against ground truth; on must-hit ray sets (a `leaks` value) it is "
+                  "leaks / rays, which is one.")
 
 
 def results_part(csv_path, rows, meta, colors, with_pareto, used):
@@ -1420,12 +1450,11 @@ def results_part(csv_path, rows, meta, colors, with_pareto, used):
     intro = {"Ratio to Embree": "Ratios are measured within one run (same rays, same machine, "
                                 "repetitions interleaved), so they are more stable across runs "
                                 "than absolute Mrays/s.",
-             "Speed versus error": "No accuracy file given (`--accuracy`): the error here is "
-                                   "1 \u2212 agree_hit, disagreement with Embree, not an error "
-                                   "against ground truth; on must-hit ray sets (a `leaks` "
-                                   "value) it is leaks / rays, which is one."}
+             "Speed versus error": NO_ACCURACY_LINE + " " + FALLBACK_ERROR}
     lines = run_section(meta, csv_path, rows)
     lines += plots_section(plots, intro)
+    if with_pareto and not any(p.section == "Speed versus error" for p in plots):
+        lines += ["## Speed versus error", "", NO_ACCURACY_LINE, ""]
     lines += tables_section(rows, scenes, backends, raysets)
     return plots, lines
 

@@ -233,6 +233,14 @@ class ReportTestCase(unittest.TestCase):
         cls.must_hit = run_report(cls.path("must-hit.csv"), "--out", cls.path("must-hit-out"))
         cls.accuracy = run_report(cls.path("run.csv"), "--out", cls.path("acc-out"),
                                   "--accuracy", cls.path("accuracy.csv"), "--title", "My title")
+        # Every backend agrees with Embree on every ray: nothing to plot against error.
+        write_csv(cls.path("agree.csv"), [dict(r, agree_hit=1) for r in results_rows()], COLUMNS)
+        cls.agree = run_report(cls.path("agree.csv"), "--out", cls.path("agree-out"))
+        # Only bvh2 on bunny's primary rays disagrees with Embree: one panel of one figure.
+        write_csv(cls.path("partly.csv"),
+                  [dict(r, agree_hit=0.99 if (r["scene"], r["rayset"], r["backend"]) ==
+                        ("bunny", "primary", "bvh2") else 1) for r in results_rows()], COLUMNS)
+        cls.partly = run_report(cls.path("partly.csv"), "--out", cls.path("partly-out"))
 
     @classmethod
     def tearDownClass(cls):
@@ -291,6 +299,37 @@ class ReportTestCase(unittest.TestCase):
         self.assertEqual(sorted(l for l in links if l.startswith("pareto-")),
                          ["pareto-bunny.png", "pareto-proc_terrain_spheres.png"])
         self.assertIn("disagreement with Embree", self.read_report(self.path("run-report")))
+
+    def test_without_accuracy_file_the_report_says_so_and_how_to_make_one(self):
+        # Issue 29: without --accuracy every backend sat at x = 0 of the speed-versus-error plots.
+        markdown, links = self.assertGoodReport(self.agree, self.path("agree-out"))
+        self.assertEqual([l for l in links if l.startswith("pareto-")], [])
+        section = markdown.split("## Speed versus error", 1)[1].split("\n## ", 1)[0]
+        self.assertIn("No accuracy file given", section)
+        self.assertIn("--accuracy accuracy.csv", section)
+        self.assertEqual(markdown.count("No accuracy file given"), 1)
+        for name in ("run-report", "must-hit-out"):
+            self.assertIn("No accuracy file given", self.read_report(self.path(name)))
+        self.assertNotIn("No accuracy file given", self.read_report(self.path("acc-out")))
+
+    def test_panels_where_every_backend_is_at_zero_are_left_out(self):
+        markdown, links = self.assertGoodReport(self.partly, self.path("partly-out"))
+        self.assertEqual([l for l in links if l.startswith("pareto-")], ["pareto-bunny.png"])
+        section = markdown.split("## Speed versus error", 1)[1].split("\n## ", 1)[0]
+        self.assertIn("Not plotted, every backend at 0: shadow.", section)
+
+    def test_tables_show_ties_and_t_error(self):
+        markdown = self.read_report(self.path("run-report"))
+        tables = markdown.split("## Tables", 1)[1]
+        primary, shadow = tables.split("### shadow rays", 1)
+        header = [l for l in primary.splitlines() if l.startswith("| scene")][0]
+        self.assertTrue(header.endswith("| ties | t relerr max | t relerr p99.9 |"), header)
+        bvh2 = [l for l in primary.splitlines() if l.startswith("| bunny | bvh2 |")][0]
+        self.assertTrue(bvh2.endswith("| 0 | 1e-6 | 1e-7 |"), bvh2)
+        # Shadow rays have no t: those columns are left out, not filled with dashes.
+        header = [l for l in shadow.splitlines() if l.startswith("| scene")][0]
+        self.assertNotIn("t relerr", header)
+        self.assertIn("| ties |", header)
 
     def test_run_section_from_meta(self):
         markdown = self.read_report(self.path("run-report"))
@@ -387,6 +426,9 @@ class AccuracyReportTestCase(ReportTestCase):
     test_accuracy_file_gives_pareto_plots = None
     test_must_hit_rayset_shows_leaks = None
     test_help = None
+    test_without_accuracy_file_the_report_says_so_and_how_to_make_one = None
+    test_panels_where_every_backend_is_at_zero_are_left_out = None
+    test_tables_show_ties_and_t_error = None
 
     def test_accuracy_alone(self):
         markdown, links = self.assertGoodReport(self.alone, self.path("acc-report"))
