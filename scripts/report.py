@@ -516,6 +516,15 @@ def symlog_threshold(errors, rays):
 
 def plot_pareto(path, panels, colors, title, notes):
     """panels: [(rayset, [point]), ...]; point: dict(backend, error, speed, rays)."""
+    save(pareto_figure(panels, colors, title, notes), path)
+
+
+def save(fig, path):
+    fig.savefig(path, dpi=DPI)
+    pyplot().close(fig)
+
+
+def pareto_figure(panels, colors, title, notes):
     plt = pyplot()
     ncols = min(len(panels), 4)
     nrows = math.ceil(len(panels) / ncols)
@@ -528,8 +537,7 @@ def plot_pareto(path, panels, colors, title, notes):
     legend = ("filled: the Pareto front (dashed line), no other backend both faster and more "
               "accurate; hollow: dominated")
     fig.suptitle(wrap_title("\n".join([title, *notes, legend]), fig))
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    return fig
 
 
 def draw_pareto_panel(ax, rayset, points, colors):
@@ -709,19 +717,43 @@ def percent_formatter():
         .replace("e+", "e") + " %")
 
 
+# Labelled ticks an axis of a panel holds without overlap: x labels such as "0.0001 %" are
+# about 0.6 in wide on a 3.5 in axis; y labels only need a line of height each.
+MAX_X_LABELS, MAX_Y_LABELS = 5, 8
+
+
+def symlog_ticks(axis, linthresh, top, max_labels):
+    """Ticks of a symlog axis (linear scale 1: 0 to linthresh is one decade wide): 0, then
+    powers of ten from linthresh up, every `stride`-th labelled so that at most max_labels
+    labels show, the others minor ticks. matplotlib's own locator also puts labelled ticks at
+    the powers of ten inside the linear region, squeezed against 0, where they overlap.
+    With a stride of k the first labelled decade is k decades above 0, as every other gap."""
+    from matplotlib.ticker import FixedLocator, NullFormatter
+    first = math.ceil(math.log10(linthresh) - 1e-9)
+    last = math.floor(math.log10(top) + 1e-9) if top > 0 else first
+    decades = list(range(first, max(first, last) + 1))
+    stride = max(1, math.ceil(len(decades) / max(max_labels - 1, 1)))
+    labelled = decades[stride - 1::stride]
+    axis.set_major_locator(FixedLocator([0.0] + [10.0 ** d for d in labelled]))
+    axis.set_minor_locator(FixedLocator([10.0 ** d for d in decades if d not in labelled]))
+    axis.set_minor_formatter(NullFormatter())
+
+
 def error_axis(ax, which, errors, rays, percent):
     """A symlog error axis: linear below one ray's worth, where the many exact zeros sit,
     logarithmic above, so 0.001 % and 10 % are both readable."""
     threshold = symlog_threshold(errors, rays)
     top = min(max(max(errors, default=0.0) * 4, threshold * 100), 2.0 if percent else math.inf)
+    axis = ax.xaxis if which == "x" else ax.yaxis
     if which == "x":
-        ax.set_xscale("symlog", linthresh=threshold, linscale=0.6)
+        ax.set_xscale("symlog", linthresh=threshold, linscale=1.0)
         ax.set_xlim(-0.6 * threshold, top)
     else:
-        ax.set_yscale("symlog", linthresh=threshold, linscale=0.6)
+        ax.set_yscale("symlog", linthresh=threshold, linscale=1.0)
         ax.set_ylim(-0.6 * threshold, top)
+    symlog_ticks(axis, threshold, top, MAX_X_LABELS if which == "x" else MAX_Y_LABELS)
     if percent:
-        (ax.xaxis if which == "x" else ax.yaxis).set_major_formatter(percent_formatter())
+        axis.set_major_formatter(percent_formatter())
 
 
 def number_axis(ax, values):
@@ -733,7 +765,8 @@ def number_axis(ax, values):
     if positive and len(positive) == len(values) and wide_range(values, 8):
         ax.set_xscale("log")
     elif positive and any(v == 0 for v in values) and wide_range(positive, 8):
-        ax.set_xscale("symlog", linthresh=min(positive), linscale=0.6)
+        ax.set_xscale("symlog", linthresh=min(positive), linscale=1.0)
+        symlog_ticks(ax.xaxis, min(positive), max(positive), MAX_X_LABELS)
     ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: fmt_short(v)))
 
 
@@ -745,6 +778,10 @@ def plot_error_lines(path, panels, ncols, colors, title):
     scene is scaled or moved away from the origin, or as a ray-set parameter grows.
     panels: [(panel title, x label, {backend: [(x, error, rays)]})]. Backends at the same
     error overlap, so each has its own marker as well as its colour."""
+    save(error_lines_figure(panels, ncols, colors, title), path)
+
+
+def error_lines_figure(panels, ncols, colors, title):
     plt = pyplot()
     from matplotlib.lines import Line2D
     nrows = math.ceil(len(panels) / ncols)
@@ -778,8 +815,7 @@ def plot_error_lines(path, panels, ncols, colors, title):
                                                    loc="upper left", bbox_to_anchor=(1.02, 1.0),
                                                    frameon=False)
     fig.suptitle(wrap_title(title, fig))
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    return fig
 
 
 def plot_invalid_rays(path, costs, colors, title):

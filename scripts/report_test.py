@@ -2,7 +2,8 @@
 report and every PNG it links exist and are real images, the tables hold every (scene, backend)
 pair, accuracy files (alone, several, or beside a results CSV) give the speed-versus-error,
 stability-sweep, ray-set-parameter and invalid-ray plots and tables, and bad input exits 2 with
-one line on stderr and writes nothing. The data behind the accuracy plots (what is pooled, what
+one line on stderr and writes nothing. Without an accuracy file the report says so and how to
+make one; the tables show ties and t error; the symlog axes' tick labels do not overlap. The data behind the accuracy plots (what is pooled, what
 is left out, the invalid-ray cost) is also checked directly on report.py's functions.
 
     /usr/bin/python3 -m unittest scripts/report_test.py     (from the repository root)
@@ -602,6 +603,59 @@ class AccuracyDataTestCase(unittest.TestCase):
         self.assertEqual(report.fmt_rate(1), "100 %")
         # A kernel whose t overflowed has an infinite ulp error: shown, not a crash.
         self.assertEqual(report.fmt_ulp(float("inf")), "\u221e")
+
+
+class SymlogAxisTestCase(unittest.TestCase):
+    """Issue 29: the symlog error axes' labels overlapped near 0 (matplotlib labels the powers
+    of ten inside the linear region too, squeezed against 0). Drawn as the report draws them,
+    with many rays (errors down to 1e-6) and errors up to 100 %, on both kinds of figure."""
+
+    BACKENDS = ["embree", "bvh2", "bvh2:watertight", "kernel:mt_seed"]
+
+    def points(self, rays, errors):
+        return [{"backend": b, "error": e, "speed": s, "rays": rays, "kind": "accuracy"}
+                for b, e, s in zip(self.BACKENDS, errors, (10, 12, 8, 20))]
+
+    def figures(self):
+        colors = report.backend_colors(self.BACKENDS)
+        pareto = report.pareto_figure(
+            [("many rays", self.points(1_000_000, [0, 3e-6, 0.02, 0.5])),
+             ("4096 rays", self.points(4096, [0, 2.4e-4, 1e-3, 1.0])),
+             ("tiny errors", self.points(1 << 20, [0, 1e-6, 2e-6, 0])),
+             ("all zero", self.points(1 << 20, [0, 0, 0, 0]))], colors, "pareto", [])
+        offsets = [(0, 0, 1 << 20), (148376, 1e-5, 1 << 20), (1e6, 1e-3, 1 << 20),
+                   (1e7, 0.3, 1 << 20), (1e9, 1.0, 1 << 20)]
+        lines = report.error_lines_figure(
+            [("offset", "distance", {"bvh2": offsets}),
+             ("D", "D", {"embree": [(1e2, 0, 4096), (1e10, 1e-3, 4096)]})], 2, colors, "lines")
+        return [pareto, lines]
+
+    def labels(self, axis, renderer):
+        """The window boxes of the axis' visible, non-empty major tick labels, in order."""
+        lo, hi = sorted(axis.get_view_interval())
+        ticks = [t for t in axis.get_major_ticks() if lo <= t.get_loc() <= hi]
+        return [(t.get_loc(), t.label1.get_text(), t.label1.get_window_extent(renderer))
+                for t in ticks if t.label1.get_visible() and t.label1.get_text()]
+
+    def test_tick_labels_do_not_overlap(self):
+        for fig in self.figures():
+            fig.canvas.draw()
+            renderer = fig.canvas.get_renderer()
+            for ax in (a for a in fig.axes if a.get_visible()):
+                for axis in (ax.xaxis, ax.yaxis):
+                    if axis.get_scale() != "symlog":
+                        continue
+                    labels = self.labels(axis, renderer)
+                    self.assertGreaterEqual(len(labels), 2, ax.get_title())
+                    for i, (_, a, box_a) in enumerate(labels):
+                        for _, b, box_b in labels[i + 1:]:
+                            self.assertFalse(box_a.overlaps(box_b),
+                                             f"{ax.get_title()}: {a!r} overlaps {b!r}")
+                    # In the linear region (|v| < linthresh) only 0 is labelled.
+                    linthresh = axis.get_transform().linthresh
+                    self.assertEqual([text for v, text, _ in labels if abs(v) < linthresh],
+                                     ["0"], ax.get_title())
+            report.pyplot().close(fig)
 
 
 class BadInputTestCase(unittest.TestCase):
