@@ -32,8 +32,9 @@ wrong_prim, fractions of rays, shown as %):
   per backend, time per invalid ray / time per valid ray = mrays_s(control-random) /
   mrays_s(invalid-rays), with Embree's bar (2.5x) dashed, and a table saying whether each
   backend stays within it and answers every invalid ray as a miss (false_hit = 0);
-- a table per scene (as given) with every row: rays, error, false miss, false hit, wrong prim,
-  ambiguous, self hits, ulp p50/p99/max, Mrays/s.
+- a table per scene (as given) with every row: rays, truth hits, error, false miss, false hit,
+  wrong prim, ambiguous, self hits, ulp p50/p99/max, Mrays/s; the file's summary names the ray
+  sets whose exact truth has no hit (they can only catch false hits).
 
 The report starts with a "Run" section from the sidecar <csv without .csv>.meta.toml when
 RESULTS.csv has one (an accuracy file's sidecar, if any, is summarised in its own section);
@@ -1032,7 +1033,7 @@ def unique_name(stem, used):
 # One accuracy file: what to plot, and its part of the report
 
 
-ACCURACY_HEADER = ["ray set", "backend", "class", "rays", "error", "false miss", "false hit",
+ACCURACY_HEADER = ["ray set", "backend", "class", "rays", "truth hits", "error", "false miss", "false hit",
                    "wrong prim", "ambiguous", "self hits", "ulp p50", "ulp p99", "ulp max",
                    "Mrays/s"]
 
@@ -1040,7 +1041,7 @@ ACCURACY_HEADER = ["ray set", "backend", "class", "rays", "error", "false miss",
 def accuracy_cells(row):
     return [md_escape(rayset_label(row["rayset"], row["query"])), md_escape(row["backend"]),
             md_escape(row["accuracy_class"]) or DASH, f"{row['rays']:,}",
-            fmt_rate(error_rate(row)), fmt_rate(row["false_miss"]), fmt_rate(row["false_hit"]),
+            fmt_rate(row["truth_hits"]), fmt_rate(error_rate(row)), fmt_rate(row["false_miss"]), fmt_rate(row["false_hit"]),
             fmt_rate(row["wrong_prim"]), fmt_rate(row["ambiguous"]), fmt_rate(row["self_hits"]),
             fmt_ulp(row["ulp_p50"]), fmt_ulp(row["ulp_p99"]), fmt_ulp(row["ulp_max"]),
             fmt_sig(row["mrays_s"])]
@@ -1308,6 +1309,14 @@ SECTION_INTROS = {
 }
 
 
+def miss_only_raysets(rows):
+    """(scene, ray set) of the scene as given whose exact truth has no hit in any row."""
+    groups = group_by([r for r in rows if r["transform"] == IDENTITY],
+                      lambda r: (r["scene"], r["rayset"]))
+    return [key for key, group in groups.items()
+            if all(r["truth_hits"] is not None and r["truth_hits"] == 0 for r in group)]
+
+
 def accuracy_summary(acc):
     rows = acc.rows
     scenes = ordered(scene_family(r["scene"]) for r in rows)
@@ -1320,8 +1329,15 @@ def accuracy_summary(acc):
     if acc.meta:
         lines.append(f"- Metadata: `{os.path.basename(meta_path(acc.path))}`")
         lines += [f"- {label}: {text}" for label, text in run_facts(acc.meta) if text]
+    no_hits = miss_only_raysets(rows)
+    if no_hits:
+        lines.append("- Ray sets with no hit in the exact truth (they can only catch false hits; "
+                     "meant so for invalid-rays, behind-origin, degenerate-triangles and "
+                     "coplanar): "
+                     + ", ".join(f"`{scene} {rayset}`" for scene, rayset in no_hits))
     return lines + [
-        "", "Rates are % of the row's rays, judged against the exact referee; error = false "
+        "", "Rates are % of the row's rays, judged against the exact referee; truth hits = rays "
+        "the referee says hit; error = false "
         "miss + false hit + wrong prim (a hit on a triangle the referee does not accept, "
         "unambiguous rays only). Ambiguous rays lie within rounding of an edge or vertex. Self "
         "hits: secondary rays that hit the primitive they start from. ulp: |t \u2212 t_exact| "

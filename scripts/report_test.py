@@ -523,6 +523,21 @@ class AccuracyReportTestCase(ReportTestCase):
         self.assertEqual(invalid[("prim:box", "kernel:pbrt")]["invalid / valid time"], "1.5\u00d7")
 
 
+    def test_ray_sets_without_a_true_hit_are_named(self):
+        # Issue 29: kernel-level sets whose truth had no hit read as "0 error" and tested nothing.
+        markdown = self.read_report(self.path("both-out"))
+        kernels = markdown.split("## Accuracy: `kernels.csv`", 1)[1]
+        line = [l for l in kernels.splitlines() if l.startswith("- Ray sets with no hit")]
+        self.assertEqual(len(line), 1, kernels[:2000])
+        self.assertTrue(line[0].endswith(": `prim:sphere invalid-rays`, `prim:box invalid-rays`"),
+                        line[0])
+        acc = markdown.split("## Accuracy: `acc.csv`", 1)[1].split("## Accuracy: `kernels.csv`")[0]
+        self.assertIn("coplanar): `bunny invalid-rays`, `proc:terrain_spheres invalid-rays`\n", acc)
+        rows = table_rows(section(section(kernels, "### Results by scene"), "#### prim:box"))
+        self.assertEqual({r["ray set"]: r["truth hits"] for r in rows},
+                         {"control-random": "50 %", "invalid-rays": "0"})
+
+
 class AccuracyDataTestCase(unittest.TestCase):
     """What goes into each accuracy plot, from report.py's functions on a parsed file."""
 
