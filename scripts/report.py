@@ -10,7 +10,9 @@ Writes DIR/report.md (default DIR: <dir>/<stem>-report/ of RESULTS.csv, or of th
 - ratio-<rayset>[-t<threads>].png: each non-Embree backend's ratio_to_embree per scene;
 - pareto-<scene>[-t<threads>].png, only without --accuracy: speed versus 1 - agree_hit, which
   is disagreement with Embree, not error against a ground truth (on must-hit ray sets, which
-  have a `leaks` count, leaks / rays, which is).
+  have a `leaks` count, leaks / rays, which is). Ray sets on which every backend sits at 0 are
+  left out (all points on one vertical line); the report says, in one line, that no accuracy
+  file was given and how to make one.
 
 From each --accuracy file (results/accuracy.csv, results/accuracy-kernels.csv; the schema is
 harness/src/accuracy/accuracy_csv.h; every row is one thread; error = false_miss + false_hit +
@@ -30,8 +32,9 @@ wrong_prim, fractions of rays, shown as %):
   per backend, time per invalid ray / time per valid ray = mrays_s(control-random) /
   mrays_s(invalid-rays), with Embree's bar (2.5x) dashed, and a table saying whether each
   backend stays within it and answers every invalid ray as a miss (false_hit = 0);
-- a table per scene (as given) with every row: rays, error, false miss, false hit, wrong prim,
-  ambiguous, self hits, ulp p50/p99/max, Mrays/s.
+- a table per scene (as given) with every row: rays, truth hits, error, false miss, false hit,
+  wrong prim, ambiguous, self hits, ulp p50/p99/max, Mrays/s; the file's summary names the ray
+  sets whose exact truth has no hit (they can only catch false hits).
 
 The report starts with a "Run" section from the sidecar <csv without .csv>.meta.toml when
 RESULTS.csv has one (an accuracy file's sidecar, if any, is summarised in its own section);
@@ -514,6 +517,15 @@ def symlog_threshold(errors, rays):
 
 def plot_pareto(path, panels, colors, title, notes):
     """panels: [(rayset, [point]), ...]; point: dict(backend, error, speed, rays)."""
+    save(pareto_figure(panels, colors, title, notes), path)
+
+
+def save(fig, path):
+    fig.savefig(path, dpi=DPI)
+    pyplot().close(fig)
+
+
+def pareto_figure(panels, colors, title, notes):
     plt = pyplot()
     ncols = min(len(panels), 4)
     nrows = math.ceil(len(panels) / ncols)
@@ -526,8 +538,7 @@ def plot_pareto(path, panels, colors, title, notes):
     legend = ("filled: the Pareto front (dashed line), no other backend both faster and more "
               "accurate; hollow: dominated")
     fig.suptitle(wrap_title("\n".join([title, *notes, legend]), fig))
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    return fig
 
 
 def draw_pareto_panel(ax, rayset, points, colors):
@@ -707,19 +718,43 @@ def percent_formatter():
         .replace("e+", "e") + " %")
 
 
+# Labelled ticks an axis of a panel holds without overlap: x labels such as "0.0001 %" are
+# about 0.6 in wide on a 3.5 in axis; y labels only need a line of height each.
+MAX_X_LABELS, MAX_Y_LABELS = 5, 8
+
+
+def symlog_ticks(axis, linthresh, top, max_labels):
+    """Ticks of a symlog axis (linear scale 1: 0 to linthresh is one decade wide): 0, then
+    powers of ten from linthresh up, every `stride`-th labelled so that at most max_labels
+    labels show, the others minor ticks. matplotlib's own locator also puts labelled ticks at
+    the powers of ten inside the linear region, squeezed against 0, where they overlap.
+    With a stride of k the first labelled decade is k decades above 0, as every other gap."""
+    from matplotlib.ticker import FixedLocator, NullFormatter
+    first = math.ceil(math.log10(linthresh) - 1e-9)
+    last = math.floor(math.log10(top) + 1e-9) if top > 0 else first
+    decades = list(range(first, max(first, last) + 1))
+    stride = max(1, math.ceil(len(decades) / max(max_labels - 1, 1)))
+    labelled = decades[stride - 1::stride]
+    axis.set_major_locator(FixedLocator([0.0] + [10.0 ** d for d in labelled]))
+    axis.set_minor_locator(FixedLocator([10.0 ** d for d in decades if d not in labelled]))
+    axis.set_minor_formatter(NullFormatter())
+
+
 def error_axis(ax, which, errors, rays, percent):
     """A symlog error axis: linear below one ray's worth, where the many exact zeros sit,
     logarithmic above, so 0.001 % and 10 % are both readable."""
     threshold = symlog_threshold(errors, rays)
     top = min(max(max(errors, default=0.0) * 4, threshold * 100), 2.0 if percent else math.inf)
+    axis = ax.xaxis if which == "x" else ax.yaxis
     if which == "x":
-        ax.set_xscale("symlog", linthresh=threshold, linscale=0.6)
+        ax.set_xscale("symlog", linthresh=threshold, linscale=1.0)
         ax.set_xlim(-0.6 * threshold, top)
     else:
-        ax.set_yscale("symlog", linthresh=threshold, linscale=0.6)
+        ax.set_yscale("symlog", linthresh=threshold, linscale=1.0)
         ax.set_ylim(-0.6 * threshold, top)
+    symlog_ticks(axis, threshold, top, MAX_X_LABELS if which == "x" else MAX_Y_LABELS)
     if percent:
-        (ax.xaxis if which == "x" else ax.yaxis).set_major_formatter(percent_formatter())
+        axis.set_major_formatter(percent_formatter())
 
 
 def number_axis(ax, values):
@@ -731,7 +766,8 @@ def number_axis(ax, values):
     if positive and len(positive) == len(values) and wide_range(values, 8):
         ax.set_xscale("log")
     elif positive and any(v == 0 for v in values) and wide_range(positive, 8):
-        ax.set_xscale("symlog", linthresh=min(positive), linscale=0.6)
+        ax.set_xscale("symlog", linthresh=min(positive), linscale=1.0)
+        symlog_ticks(ax.xaxis, min(positive), max(positive), MAX_X_LABELS)
     ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: fmt_short(v)))
 
 
@@ -743,6 +779,10 @@ def plot_error_lines(path, panels, ncols, colors, title):
     scene is scaled or moved away from the origin, or as a ray-set parameter grows.
     panels: [(panel title, x label, {backend: [(x, error, rays)]})]. Backends at the same
     error overlap, so each has its own marker as well as its colour."""
+    save(error_lines_figure(panels, ncols, colors, title), path)
+
+
+def error_lines_figure(panels, ncols, colors, title):
     plt = pyplot()
     from matplotlib.lines import Line2D
     nrows = math.ceil(len(panels) / ncols)
@@ -776,8 +816,7 @@ def plot_error_lines(path, panels, ncols, colors, title):
                                                    loc="upper left", bbox_to_anchor=(1.02, 1.0),
                                                    frameon=False)
     fig.suptitle(wrap_title(title, fig))
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    return fig
 
 
 def plot_invalid_rays(path, costs, colors, title):
@@ -956,10 +995,14 @@ def pareto_plots(groups, raysets, colors, triangles, used):
     plots = []
     for scene in scenes:
         for threads in all_threads:
-            panels = [(rs, groups[(scene, rs, threads)]) for rs in raysets
-                      if (scene, rs, threads) in groups]
+            # A panel where every backend sits at error 0 says nothing the throughput plot
+            # does not: left out, and named in the sentence.
+            present = [rs for rs in raysets if (scene, rs, threads) in groups]
+            panels = [(rs, groups[(scene, rs, threads)]) for rs in present
+                      if any(p["error"] > 0 for p in groups[(scene, rs, threads)])]
             if not panels:
                 continue
+            left_out = [rs for rs in present if rs not in dict(panels)]
             kinds = {p["kind"] for _, points in panels for p in points}
             suffix = f"-t{threads}" if len(all_threads) > 1 and threads is not None else ""
             filename = unique_name(f"pareto-{safe_name(scene)}{suffix}", used)
@@ -968,7 +1011,9 @@ def pareto_plots(groups, raysets, colors, triangles, used):
             title = (f"Speed versus error: {scene}" + (f" ({tris:,.0f} triangles)" if tris else "")
                      + (f", {thread_words(threads)}" if suffix else ""))
             notes = [ERROR_KINDS[k][1] for k in ERROR_KINDS if k in kinds]
-            plots.append(Plot("Speed versus error", heading, pareto_sentence(kinds), filename,
+            sentence = pareto_sentence(kinds) + (
+                " Not plotted, every backend at 0: " + ", ".join(left_out) + "." if left_out else "")
+            plots.append(Plot("Speed versus error", heading, sentence, filename,
                               lambda path, p=panels, t=title, n=notes: plot_pareto(
                                   path, p, colors, t, n)))
     return plots
@@ -988,7 +1033,7 @@ def unique_name(stem, used):
 # One accuracy file: what to plot, and its part of the report
 
 
-ACCURACY_HEADER = ["ray set", "backend", "class", "rays", "error", "false miss", "false hit",
+ACCURACY_HEADER = ["ray set", "backend", "class", "rays", "truth hits", "error", "false miss", "false hit",
                    "wrong prim", "ambiguous", "self hits", "ulp p50", "ulp p99", "ulp max",
                    "Mrays/s"]
 
@@ -996,7 +1041,7 @@ ACCURACY_HEADER = ["ray set", "backend", "class", "rays", "error", "false miss",
 def accuracy_cells(row):
     return [md_escape(rayset_label(row["rayset"], row["query"])), md_escape(row["backend"]),
             md_escape(row["accuracy_class"]) or DASH, f"{row['rays']:,}",
-            fmt_rate(error_rate(row)), fmt_rate(row["false_miss"]), fmt_rate(row["false_hit"]),
+            fmt_rate(row["truth_hits"]), fmt_rate(error_rate(row)), fmt_rate(row["false_miss"]), fmt_rate(row["false_hit"]),
             fmt_rate(row["wrong_prim"]), fmt_rate(row["ambiguous"]), fmt_rate(row["self_hits"]),
             fmt_ulp(row["ulp_p50"]), fmt_ulp(row["ulp_p99"]), fmt_ulp(row["ulp_max"]),
             fmt_sig(row["mrays_s"])]
@@ -1264,6 +1309,14 @@ SECTION_INTROS = {
 }
 
 
+def miss_only_raysets(rows):
+    """(scene, ray set) of the scene as given whose exact truth has no hit in any row."""
+    groups = group_by([r for r in rows if r["transform"] == IDENTITY],
+                      lambda r: (r["scene"], r["rayset"]))
+    return [key for key, group in groups.items()
+            if all(r["truth_hits"] is not None and r["truth_hits"] == 0 for r in group)]
+
+
 def accuracy_summary(acc):
     rows = acc.rows
     scenes = ordered(scene_family(r["scene"]) for r in rows)
@@ -1276,8 +1329,15 @@ def accuracy_summary(acc):
     if acc.meta:
         lines.append(f"- Metadata: `{os.path.basename(meta_path(acc.path))}`")
         lines += [f"- {label}: {text}" for label, text in run_facts(acc.meta) if text]
+    no_hits = miss_only_raysets(rows)
+    if no_hits:
+        lines.append("- Ray sets with no hit in the exact truth (they can only catch false hits; "
+                     "meant so for invalid-rays, behind-origin, degenerate-triangles and "
+                     "coplanar): "
+                     + ", ".join(f"`{scene} {rayset}`" for scene, rayset in no_hits))
     return lines + [
-        "", "Rates are % of the row's rays, judged against the exact referee; error = false "
+        "", "Rates are % of the row's rays, judged against the exact referee; truth hits = rays "
+        "the referee says hit; error = false "
         "miss + false hit + wrong prim (a hit on a triangle the referee does not accept, "
         "unambiguous rays only). Ambiguous rays lie within rounding of an edge or vertex. Self "
         "hits: secondary rays that hit the primitive they start from. ulp: |t \u2212 t_exact| "
@@ -1361,35 +1421,45 @@ def run_section(meta, csv_path, rows):
 
 TABLE_HEADER = ["scene", "backend", "threads", "Mrays/s [min\u2013max]", "\u00d7 Embree",
                 "hit rate", "agree_hit", "agree_prim", "build ms", "MiB"]
+# Columns a table has only when its rows fill them (older CSVs lack some; shadow rays have no
+# triangle, so no ties and no t): (CSV column, header, format).
+OPTIONAL_COLUMNS = [
+    ("prim_ties", "ties", lambda v: f"{v:,.0f}"),
+    ("t_relerr_max", "t relerr max", fmt_short),
+    ("t_relerr_p999", "t relerr p99.9", fmt_short),
+    ("leaks", "leaks", lambda v: f"{v:,.0f}"),
+]
 
 
-def table_row(row, with_leaks):
+def table_row(row, optional):
     cells = [md_escape(row["scene"]), md_escape(row["backend"]), str(row["threads"]),
              fmt_throughput(row), fmt_sig(row["ratio_to_embree"]), fmt_percent(row["hit_rate"]),
              fmt_fraction(row["agree_hit"]), fmt_fraction(row["agree_prim"]),
              fmt_sig(row.get("build_ms")), fmt_mib(row.get("memory_bytes"))]
-    if with_leaks:
-        cells.append(DASH if row.get("leaks") is None else f"{row['leaks']:,.0f}")
+    for column, _, fmt in optional:
+        cells.append(DASH if row.get(column) is None else fmt(row[column]))
     return cells
 
 
 def tables_section(rows, scenes, backends, raysets):
     lines = ["## Tables", "",
              f"Empty cells ({DASH}) are not applicable: occlusion queries report no triangle, "
-             "so shadow rays have no agree_prim. Hit rate is the fraction of rays the backend "
-             "reports hit (occluded for shadow rays); leaks, on must-hit ray sets only, counts "
-             "the rays it lets through a closed mesh.", ""]
+             "so shadow rays have no agree_prim and no t error. Hit rate is the fraction of rays "
+             "the backend reports hit (occluded for shadow rays). Where the CSV has them: ties "
+             "counts the rays both hit on which another triangle lies at the same t (a differing "
+             "triangle there is no disagreement); t relerr max and p99.9 are the largest and the "
+             "99.9th percentile of |t \u2212 t_Embree| / |t_Embree| over the rays both hit; leaks, "
+             "on must-hit ray sets only, counts the rays a backend lets through a closed mesh.", ""]
     for rayset in raysets:
         subset = sorted((r for r in rows if r["rayset"] == rayset),
                         key=lambda r: (scenes.index(r["scene"]), r["threads"],
                                        backends.index(r["backend"])))
-        # Must-hit ray sets count the rays a backend lets through a closed mesh.
-        with_leaks = any(r.get("leaks") is not None for r in subset)
-        header = TABLE_HEADER + (["leaks"] if with_leaks else [])
+        optional = [c for c in OPTIONAL_COLUMNS if any(r.get(c[0]) is not None for r in subset)]
+        header = TABLE_HEADER + [name for _, name, _ in optional]
         lines += [f"### {rayset_caption(rows, rayset)}", "",
                   "| " + " | ".join(header) + " |",
                   "|" + "|".join("---:" if i >= 3 else "---" for i in range(len(header))) + "|"]
-        lines += ["| " + " | ".join(table_row(r, with_leaks)) + " |" for r in subset]
+        lines += ["| " + " | ".join(table_row(r, optional)) + " |" for r in subset]
         lines.append("")
     return lines
 
@@ -1403,6 +1473,18 @@ def plots_section(plots, intro):
         for p in (p for p in plots if p.section == section):
             lines += [f"### {p.heading}", "", p.sentence, "", f"![{p.heading}]({p.filename})", ""]
     return lines
+
+
+# Without --accuracy there is no error against ground truth: the report says so, and how to
+# get one, in the speed-versus-error section, whether or not any panel is left to draw.
+NO_ACCURACY_LINE = ("**No accuracy file given, so no error rates against ground truth.** Make "
+                    "one with `raybench run ... --accuracy accuracy.csv` (every ray judged by "
+                    "the exact referee; `scripts/accuracy` runs the whole accuracy suite) and "
+                    "pass it as `scripts/report RESULTS.csv --accuracy accuracy.csv`. Ray sets "
+                    "on which every backend agrees with Embree are not plotted here.")
+FALLBACK_ERROR = ("Below, the error is 1 \u2212 agree_hit, disagreement with Embree, not an "
+                  "error against ground truth; on must-hit ray sets (a `leaks` value) it is "
+                  "leaks / rays, which is one.")
 
 
 def results_part(csv_path, rows, meta, colors, with_pareto, used):
@@ -1420,12 +1502,11 @@ def results_part(csv_path, rows, meta, colors, with_pareto, used):
     intro = {"Ratio to Embree": "Ratios are measured within one run (same rays, same machine, "
                                 "repetitions interleaved), so they are more stable across runs "
                                 "than absolute Mrays/s.",
-             "Speed versus error": "No accuracy file given (`--accuracy`): the error here is "
-                                   "1 \u2212 agree_hit, disagreement with Embree, not an error "
-                                   "against ground truth; on must-hit ray sets (a `leaks` "
-                                   "value) it is leaks / rays, which is one."}
+             "Speed versus error": NO_ACCURACY_LINE + " " + FALLBACK_ERROR}
     lines = run_section(meta, csv_path, rows)
     lines += plots_section(plots, intro)
+    if with_pareto and not any(p.section == "Speed versus error" for p in plots):
+        lines += ["## Speed versus error", "", NO_ACCURACY_LINE, ""]
     lines += tables_section(rows, scenes, backends, raysets)
     return plots, lines
 

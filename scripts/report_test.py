@@ -2,7 +2,8 @@
 report and every PNG it links exist and are real images, the tables hold every (scene, backend)
 pair, accuracy files (alone, several, or beside a results CSV) give the speed-versus-error,
 stability-sweep, ray-set-parameter and invalid-ray plots and tables, and bad input exits 2 with
-one line on stderr and writes nothing. The data behind the accuracy plots (what is pooled, what
+one line on stderr and writes nothing. Without an accuracy file the report says so and how to
+make one; the tables show ties and t error; the symlog axes' tick labels do not overlap. The data behind the accuracy plots (what is pooled, what
 is left out, the invalid-ray cost) is also checked directly on report.py's functions.
 
     /usr/bin/python3 -m unittest scripts/report_test.py     (from the repository root)
@@ -233,6 +234,14 @@ class ReportTestCase(unittest.TestCase):
         cls.must_hit = run_report(cls.path("must-hit.csv"), "--out", cls.path("must-hit-out"))
         cls.accuracy = run_report(cls.path("run.csv"), "--out", cls.path("acc-out"),
                                   "--accuracy", cls.path("accuracy.csv"), "--title", "My title")
+        # Every backend agrees with Embree on every ray: nothing to plot against error.
+        write_csv(cls.path("agree.csv"), [dict(r, agree_hit=1) for r in results_rows()], COLUMNS)
+        cls.agree = run_report(cls.path("agree.csv"), "--out", cls.path("agree-out"))
+        # Only bvh2 on bunny's primary rays disagrees with Embree: one panel of one figure.
+        write_csv(cls.path("partly.csv"),
+                  [dict(r, agree_hit=0.99 if (r["scene"], r["rayset"], r["backend"]) ==
+                        ("bunny", "primary", "bvh2") else 1) for r in results_rows()], COLUMNS)
+        cls.partly = run_report(cls.path("partly.csv"), "--out", cls.path("partly-out"))
 
     @classmethod
     def tearDownClass(cls):
@@ -291,6 +300,37 @@ class ReportTestCase(unittest.TestCase):
         self.assertEqual(sorted(l for l in links if l.startswith("pareto-")),
                          ["pareto-bunny.png", "pareto-proc_terrain_spheres.png"])
         self.assertIn("disagreement with Embree", self.read_report(self.path("run-report")))
+
+    def test_without_accuracy_file_the_report_says_so_and_how_to_make_one(self):
+        # Issue 29: without --accuracy every backend sat at x = 0 of the speed-versus-error plots.
+        markdown, links = self.assertGoodReport(self.agree, self.path("agree-out"))
+        self.assertEqual([l for l in links if l.startswith("pareto-")], [])
+        section = markdown.split("## Speed versus error", 1)[1].split("\n## ", 1)[0]
+        self.assertIn("No accuracy file given", section)
+        self.assertIn("--accuracy accuracy.csv", section)
+        self.assertEqual(markdown.count("No accuracy file given"), 1)
+        for name in ("run-report", "must-hit-out"):
+            self.assertIn("No accuracy file given", self.read_report(self.path(name)))
+        self.assertNotIn("No accuracy file given", self.read_report(self.path("acc-out")))
+
+    def test_panels_where_every_backend_is_at_zero_are_left_out(self):
+        markdown, links = self.assertGoodReport(self.partly, self.path("partly-out"))
+        self.assertEqual([l for l in links if l.startswith("pareto-")], ["pareto-bunny.png"])
+        section = markdown.split("## Speed versus error", 1)[1].split("\n## ", 1)[0]
+        self.assertIn("Not plotted, every backend at 0: shadow.", section)
+
+    def test_tables_show_ties_and_t_error(self):
+        markdown = self.read_report(self.path("run-report"))
+        tables = markdown.split("## Tables", 1)[1]
+        primary, shadow = tables.split("### shadow rays", 1)
+        header = [l for l in primary.splitlines() if l.startswith("| scene")][0]
+        self.assertTrue(header.endswith("| ties | t relerr max | t relerr p99.9 |"), header)
+        bvh2 = [l for l in primary.splitlines() if l.startswith("| bunny | bvh2 |")][0]
+        self.assertTrue(bvh2.endswith("| 0 | 1e-6 | 1e-7 |"), bvh2)
+        # Shadow rays have no t: those columns are left out, not filled with dashes.
+        header = [l for l in shadow.splitlines() if l.startswith("| scene")][0]
+        self.assertNotIn("t relerr", header)
+        self.assertIn("| ties |", header)
 
     def test_run_section_from_meta(self):
         markdown = self.read_report(self.path("run-report"))
@@ -387,6 +427,9 @@ class AccuracyReportTestCase(ReportTestCase):
     test_accuracy_file_gives_pareto_plots = None
     test_must_hit_rayset_shows_leaks = None
     test_help = None
+    test_without_accuracy_file_the_report_says_so_and_how_to_make_one = None
+    test_panels_where_every_backend_is_at_zero_are_left_out = None
+    test_tables_show_ties_and_t_error = None
 
     def test_accuracy_alone(self):
         markdown, links = self.assertGoodReport(self.alone, self.path("acc-report"))
@@ -480,6 +523,21 @@ class AccuracyReportTestCase(ReportTestCase):
         self.assertEqual(invalid[("prim:box", "kernel:pbrt")]["invalid / valid time"], "1.5\u00d7")
 
 
+    def test_ray_sets_without_a_true_hit_are_named(self):
+        # Issue 29: kernel-level sets whose truth had no hit read as "0 error" and tested nothing.
+        markdown = self.read_report(self.path("both-out"))
+        kernels = markdown.split("## Accuracy: `kernels.csv`", 1)[1]
+        line = [l for l in kernels.splitlines() if l.startswith("- Ray sets with no hit")]
+        self.assertEqual(len(line), 1, kernels[:2000])
+        self.assertTrue(line[0].endswith(": `prim:sphere invalid-rays`, `prim:box invalid-rays`"),
+                        line[0])
+        acc = markdown.split("## Accuracy: `acc.csv`", 1)[1].split("## Accuracy: `kernels.csv`")[0]
+        self.assertIn("coplanar): `bunny invalid-rays`, `proc:terrain_spheres invalid-rays`\n", acc)
+        rows = table_rows(section(section(kernels, "### Results by scene"), "#### prim:box"))
+        self.assertEqual({r["ray set"]: r["truth hits"] for r in rows},
+                         {"control-random": "50 %", "invalid-rays": "0"})
+
+
 class AccuracyDataTestCase(unittest.TestCase):
     """What goes into each accuracy plot, from report.py's functions on a parsed file."""
 
@@ -560,6 +618,59 @@ class AccuracyDataTestCase(unittest.TestCase):
         self.assertEqual(report.fmt_rate(1), "100 %")
         # A kernel whose t overflowed has an infinite ulp error: shown, not a crash.
         self.assertEqual(report.fmt_ulp(float("inf")), "\u221e")
+
+
+class SymlogAxisTestCase(unittest.TestCase):
+    """Issue 29: the symlog error axes' labels overlapped near 0 (matplotlib labels the powers
+    of ten inside the linear region too, squeezed against 0). Drawn as the report draws them,
+    with many rays (errors down to 1e-6) and errors up to 100 %, on both kinds of figure."""
+
+    BACKENDS = ["embree", "bvh2", "bvh2:watertight", "kernel:mt_seed"]
+
+    def points(self, rays, errors):
+        return [{"backend": b, "error": e, "speed": s, "rays": rays, "kind": "accuracy"}
+                for b, e, s in zip(self.BACKENDS, errors, (10, 12, 8, 20))]
+
+    def figures(self):
+        colors = report.backend_colors(self.BACKENDS)
+        pareto = report.pareto_figure(
+            [("many rays", self.points(1_000_000, [0, 3e-6, 0.02, 0.5])),
+             ("4096 rays", self.points(4096, [0, 2.4e-4, 1e-3, 1.0])),
+             ("tiny errors", self.points(1 << 20, [0, 1e-6, 2e-6, 0])),
+             ("all zero", self.points(1 << 20, [0, 0, 0, 0]))], colors, "pareto", [])
+        offsets = [(0, 0, 1 << 20), (148376, 1e-5, 1 << 20), (1e6, 1e-3, 1 << 20),
+                   (1e7, 0.3, 1 << 20), (1e9, 1.0, 1 << 20)]
+        lines = report.error_lines_figure(
+            [("offset", "distance", {"bvh2": offsets}),
+             ("D", "D", {"embree": [(1e2, 0, 4096), (1e10, 1e-3, 4096)]})], 2, colors, "lines")
+        return [pareto, lines]
+
+    def labels(self, axis, renderer):
+        """The window boxes of the axis' visible, non-empty major tick labels, in order."""
+        lo, hi = sorted(axis.get_view_interval())
+        ticks = [t for t in axis.get_major_ticks() if lo <= t.get_loc() <= hi]
+        return [(t.get_loc(), t.label1.get_text(), t.label1.get_window_extent(renderer))
+                for t in ticks if t.label1.get_visible() and t.label1.get_text()]
+
+    def test_tick_labels_do_not_overlap(self):
+        for fig in self.figures():
+            fig.canvas.draw()
+            renderer = fig.canvas.get_renderer()
+            for ax in (a for a in fig.axes if a.get_visible()):
+                for axis in (ax.xaxis, ax.yaxis):
+                    if axis.get_scale() != "symlog":
+                        continue
+                    labels = self.labels(axis, renderer)
+                    self.assertGreaterEqual(len(labels), 2, ax.get_title())
+                    for i, (_, a, box_a) in enumerate(labels):
+                        for _, b, box_b in labels[i + 1:]:
+                            self.assertFalse(box_a.overlaps(box_b),
+                                             f"{ax.get_title()}: {a!r} overlaps {b!r}")
+                    # In the linear region (|v| < linthresh) only 0 is labelled.
+                    linthresh = axis.get_transform().linthresh
+                    self.assertEqual([text for v, text, _ in labels if abs(v) < linthresh],
+                                     ["0"], ax.get_title())
+            report.pyplot().close(fig)
 
 
 class BadInputTestCase(unittest.TestCase):

@@ -184,6 +184,36 @@ class JsonOutput(GateTestCase):
         self.assertEqual(result.returncode, 0, result.stderr)
         self.assertEqual(json.loads(result.stdout)["rows"][0]["scene"], "tab\there")
 
+    def test_the_reference_rows_have_ratio_1_as_in_the_csv(self):
+        # Issue 29: Embree's rows said ratio 0 in JSON where the CSV and the table say 1 and "-".
+        baseline = self.write("baseline", suite_rows())
+        current = self.write("current", suite_rows(samples=(7.5, 8.0, 8.5)))
+        result = run("compare", baseline, current, "--format", "json")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        rows = json.loads(result.stdout)["rows"]
+        self.assertEqual(len(rows), 4)
+        for r in rows:
+            reference = r["backend"] == "embree"
+            self.assertIs(r["reference"], reference, r)
+            ratio = r["ratio_to_embree"]
+            if reference:
+                self.assertEqual(ratio, {"base": 1, "current": 1, "change": 0, "p_value": None,
+                                         "verdict": "reference"})
+            else:
+                self.assertAlmostEqual(ratio["base"], 1.0, places=6)
+                self.assertAlmostEqual(ratio["current"], 0.8, places=6)
+                self.assertNotEqual(ratio["verdict"], "reference")
+
+    def test_a_comparison_not_made_has_null_numbers(self):
+        baseline = self.write("baseline", suite_rows())
+        current = self.write("current", [dict(r, rays="2000") for r in suite_rows()])
+        rows = json.loads(run("compare", baseline, current, "--format", "json").stdout)["rows"]
+        bvh2 = [r for r in rows if r["backend"] == "bvh2"][0]
+        self.assertIs(bvh2["same_rays"], False)
+        for comparison in (bvh2["mrays_s"], bvh2["ratio_to_embree"]):
+            self.assertEqual(comparison, {"base": None, "current": None, "change": None, "p_value": None,
+                                          "verdict": "-"})
+
 
 class PartialFiles(GateTestCase):
     PARTIAL = METADATA + 'status = "partial"\nprogress = "1 of 2 scenes"\n'

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <set>
 #include <string>
 #include <string_view>
 
@@ -101,6 +102,32 @@ TEST(KernelAccuracy, RaySetsAreStoredAsNpyLikeEveryRaySet) {
   ASSERT_EQ(columns, 4u);  // centre xyz, radius
   EXPECT_EQ(static_cast<float>(prims[3]), set->prims[0].radius);
   EXPECT_EQ(static_cast<float>(prims[4 * 63]), set->prims[63].center.x);
+}
+
+// --- Every ray set tests something -------------------------------------------
+
+// A ray set whose exact truth is all misses tests only false hits. That is
+// the purpose of the sets in must_miss, and a mistake for any other, as
+// tiny-triangles:leg=1e-5,offset=1e3 was (its triangles all collapsed in
+// float). far-small-sphere:D=1e10 is a false-hit test in all but name: its
+// sphere (1e-10 rad) is far below the float direction's resolution, so its
+// few hits are chance (3 of 4096 rays; none of these 256).
+TEST(KernelAccuracy, EveryRaySetHasAHitUnlessItIsMeantToMiss) {
+  const std::set<std::string> must_miss = {"invalid-rays", "behind-origin", "degenerate-triangles:collinear",
+                                           "degenerate-triangles:repeated", "coplanar"};
+  const std::set<std::string> hits_by_chance = {"far-small-sphere:D=1e10"};
+  std::map<std::pair<std::string, std::string>, double> truth;  // (scene, rayset) -> truth_hits
+  for (const AccuracyRow& r : all_rows()) {
+    const auto [it, fresh] = truth.emplace(std::pair{r.scene, r.rayset}, r.truth_hits);
+    EXPECT_EQ(it->second, r.truth_hits) << r.scene << " " << r.rayset << ": the truth depends on the variant";
+  }
+  ASSERT_GT(truth.size(), 40u);
+  for (const auto& [key, hits] : truth) {
+    if (must_miss.count(key.second))
+      EXPECT_EQ(hits, 0.0) << key.first << " " << key.second << " is meant to miss";
+    else if (!hits_by_chance.count(key.second))
+      EXPECT_GT(hits, 0.0) << key.first << " " << key.second << ": no ray hits, the set tests nothing";
+  }
 }
 
 // --- G15: every seed hits invalid rays; no fixed variant does -----------------

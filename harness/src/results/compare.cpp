@@ -34,11 +34,13 @@ std::string row_key(const Row& r) {
 std::string match_key(const Row& r) {
   return r.at("scene") + '\n' + r.at("rayset") + '\n' + r.at("backend") + '\n' + r.at("threads");
 }
+// Every ratio_to_embree is a backend's throughput over this backend's.
+constexpr const char* kReferenceBackend = "embree";
 // The key of the Embree row measured beside `r`: same scene, rayset, threads.
 std::string reference_key(const Row& r) {
-  return r.at("scene") + '\n' + r.at("rayset") + '\n' + "embree" + '\n' + r.at("threads");
+  return r.at("scene") + '\n' + r.at("rayset") + '\n' + kReferenceBackend + '\n' + r.at("threads");
 }
-bool is_reference(const Row& r) { return r.at("backend") == "embree"; }
+bool is_reference(const Row& r) { return r.at("backend") == kReferenceBackend; }
 
 // Each row of a file by its match_key.
 class RowIndex {
@@ -361,16 +363,23 @@ std::string format_comparison(const Comparison& c, const ResultsFile& base, cons
       for (const auto& ch : r.changes)
         changes += (changes.empty() ? "" : ", ") + fmt::format("{{\"column\": {}, \"base\": {}, \"current\": {}}}",
                                                                json_string(ch.column), json_string(ch.base), json_string(ch.current));
+      // A comparison that was not made (different ray counts) has null numbers.
       const auto sample = [&](const SampleComparison& s) {
+        const bool made = s.verdict != Verdict::kNotApplicable;
+        const auto number = [&](double v) { return made ? json_number(v) : std::string("null"); };
         return fmt::format("{{\"base\": {}, \"current\": {}, \"change\": {}, \"p_value\": {}, \"verdict\": {}}}",
-                           json_number(s.base), json_number(s.current), json_number(s.change), json_number(s.p_value),
+                           number(s.base), number(s.current), number(s.change), number(s.p_value),
                            json_string(to_string(s.verdict)));
       };
+      // The reference backend's own ratio is 1 by definition, as the CSV says (see compare.h).
+      const bool reference = r.backend == kReferenceBackend;
+      const std::string ratio =
+          reference ? R"({"base": 1, "current": 1, "change": 0, "p_value": null, "verdict": "reference"})" : sample(r.ratio);
       out += fmt::format(
-          "    {{\"scene\": {}, \"rayset\": {}, \"backend\": {}, \"threads\": {}, \"same_rays\": {}, \"mrays_s\": {}, "
-          "\"ratio_to_embree\": {}, \"changes\": [{}]}}{}\n",
-          json_string(r.scene), json_string(r.rayset), json_string(r.backend), r.threads, r.same_rays ? "true" : "false",
-          sample(r.throughput), sample(r.ratio), changes, i + 1 < c.rows.size() ? "," : "");
+          "    {{\"scene\": {}, \"rayset\": {}, \"backend\": {}, \"threads\": {}, \"reference\": {}, "
+          "\"same_rays\": {}, \"mrays_s\": {}, \"ratio_to_embree\": {}, \"changes\": [{}]}}{}\n",
+          json_string(r.scene), json_string(r.rayset), json_string(r.backend), r.threads, reference ? "true" : "false",
+          r.same_rays ? "true" : "false", sample(r.throughput), ratio, changes, i + 1 < c.rows.size() ? "," : "");
     }
     const auto list = [&](const std::vector<std::string>& v) {
       std::string s;

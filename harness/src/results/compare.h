@@ -123,6 +123,14 @@ struct Comparison {
 
 Comparison compare_results(const ResultsFile& base, const ResultsFile& current, const CompareOptions& options);
 
+// --format json: {"base", "current", "rows": [...], "only_in_base", "only_in_current",
+// "notes"}. Each row has scene, rayset, backend, threads, "reference" (true on
+// the Embree rows, the reference of every ratio), same_rays, changes, and two
+// comparisons {base, current, change, p_value, verdict}: "mrays_s" and
+// "ratio_to_embree". The reference rows' ratio is what the CSV says, 1 in
+// both runs: {base 1, current 1, change 0, p_value null, verdict "reference"}.
+// A comparison not made (the runs traced different ray counts) has null
+// numbers and verdict "-".
 enum class OutputFormat { kTable, kMarkdown, kJson };
 std::string format_comparison(const Comparison& c, const ResultsFile& base, const ResultsFile& current,
                               OutputFormat format, bool colour);
