@@ -70,9 +70,11 @@ using BackendFactory = std::unique_ptr<Backend> (*)(const std::string& name, con
 using BackendNames = std::vector<BackendInfo> (*)();
 
 // Adds a family to the registry; RAYBENCH_BACKEND_FAMILY calls it while the
-// program starts. `order` places the family in list_backends() (ascending;
-// embree 100, bvh2 200, bvh8 300, bvh4 400, reference 900). Throws
-// std::logic_error for a family name registered twice.
+// program starts, so the registry is complete once main() runs (do not ask
+// it from another file's static initialiser; gtest evaluates
+// INSTANTIATE_TEST_SUITE_P's ValuesIn from main). `order` places the family
+// in list_backends() (ascending; embree 100, bvh2 200, bvh8 300, bvh4 400,
+// reference 900). Throws std::logic_error for a family name registered twice.
 bool register_backend_family(std::string family, int order, BackendFactory make, BackendNames names);
 
 // Registers a backend family from its own .cpp in harness/src/backends/, at
@@ -81,7 +83,7 @@ bool register_backend_family(std::string family, int order, BackendFactory make,
 // backend_accuracy_class find it by name. The harness is an OBJECT library
 // (harness/CMakeLists.txt) so that the linker keeps this file although
 // nothing refers to it.
-#define RAYBENCH_BACKEND_FAMILY(family, order, make, names)                             \
+#define RAYBENCH_BACKEND_FAMILY(family, order, make, names)                                    \
   [[maybe_unused]] static const bool RAYBENCH_BACKEND_CAT_(raybench_backend_family_, __LINE__) = \
       ::raybench::register_backend_family(family, order, make, names)
 #define RAYBENCH_BACKEND_CAT_(a, b) RAYBENCH_BACKEND_PASTE_(a, b)
