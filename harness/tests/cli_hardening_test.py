@@ -10,42 +10,16 @@ Run through ctest (harness/tests/CMakeLists.txt sets RAYBENCH and the mesh folde
 """
 import os
 import stat
-import subprocess
-import tempfile
 import unittest
 
 import numpy as np
 
-RAYBENCH = os.environ["RAYBENCH"]
+from cli_testing import CliTestCase, run
 SCENE = "proc:terrain_spheres_small"
 BACKENDS = ("embree", "bvh2", "bvh8", "bvh4", "reference")
 
 
-def run(*args, timeout=300):
-    return subprocess.run([RAYBENCH, *args], capture_output=True, text=True, timeout=timeout)
-
-
-class HardeningTestCase(unittest.TestCase):
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory()
-        self.dir = self.tmp.name
-
-    def tearDown(self):
-        self.tmp.cleanup()
-
-    def path(self, *names):
-        return os.path.join(self.dir, *names)
-
-    def assertBadInput(self, result, *fragments):
-        """Exit 2 and one error line on stderr, the last, naming each fragment (progress lines may precede it)."""
-        self.assertEqual(result.returncode, 2, result.stderr)
-        lines = result.stderr.strip().splitlines()
-        errors = [line for line in lines if line.startswith("raybench: error: ")]
-        self.assertEqual(len(errors), 1, result.stderr)
-        self.assertEqual(errors[0], lines[-1], result.stderr)
-        for fragment in fragments:
-            self.assertIn(fragment, errors[0])
-        return errors[0]
+class HardeningTestCase(CliTestCase):
 
     def manifest(self, text, name="suite.toml"):
         path = self.path(name)

@@ -7,44 +7,19 @@ Run through ctest (harness/tests/CMakeLists.txt sets RAYBENCH and the mesh folde
 import csv
 import json
 import os
-import subprocess
 import tempfile
 import tomllib
 import unittest
 
 import numpy as np
 
-RAYBENCH = os.environ["RAYBENCH"]
-MODELS = os.environ.get("RAYBENCH_ASSIMP_MODELS", "/usr/share/assimp/models")
+from cli_testing import MODELS, CliTestCase, run
 WUSON = os.path.join(MODELS, "PLY", "Wuson.ply")
 POND = os.path.join(MODELS, "PLY", "pond.0.ply")
 SCENE = "proc:terrain_spheres_small"
 
 
-def run(*args):
-    return subprocess.run([RAYBENCH, *args], capture_output=True, text=True, timeout=300)
-
-
-class CliTestCase(unittest.TestCase):
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory()
-        self.dir = self.tmp.name
-
-    def tearDown(self):
-        self.tmp.cleanup()
-
-    def path(self, *names):
-        return os.path.join(self.dir, *names)
-
-    def assertBadInput(self, result, *fragments):
-        """Exit 2 and one error line on stderr, the last, naming each fragment (progress lines may precede it)."""
-        self.assertEqual(result.returncode, 2, result.stderr)
-        lines = result.stderr.strip().splitlines()
-        errors = [line for line in lines if line.startswith("raybench: error: ")]
-        self.assertEqual(len(errors), 1, result.stderr)
-        self.assertEqual(errors[0], lines[-1], result.stderr)
-        for fragment in fragments:
-            self.assertIn(fragment, errors[0])
+class CliTest(CliTestCase):
 
     def make_rays(self, kind="primary", count=2000, scene=SCENE):
         out = self.path(f"{kind}.npy")
@@ -53,7 +28,7 @@ class CliTestCase(unittest.TestCase):
         return out
 
 
-class RayFiles(CliTestCase):
+class RayFiles(CliTest):
     def test_rays_are_float32_n_by_8_and_readable_by_numpy(self):
         rays = np.load(self.make_rays("diffuse", 1500))
         self.assertEqual(rays.dtype, np.float32)
@@ -112,7 +87,7 @@ class RayFiles(CliTestCase):
             self.assertTrue(np.all(hits[1:7, 1] == -1), f"{backend}: {hits}")
 
 
-class BadInput(CliTestCase):
+class BadInput(CliTest):
     def trace(self, rays, scene=SCENE, backend="bvh2"):
         out = self.path("hits.npy")
         result = run("trace", "--scene", scene, "--rays", rays, "-b", backend, "-o", out)
@@ -168,7 +143,7 @@ class BadInput(CliTestCase):
         self.assertEqual(run("run", "--help").returncode, 0)
 
 
-class SuiteRun(CliTestCase):
+class SuiteRun(CliTest):
     def test_a_small_run_writes_the_schema_and_metadata(self):
         suite = self.path("suite.toml")
         with open(suite, "w") as f:
@@ -273,7 +248,7 @@ def write_csv(path, fields, rows):
         writer.writerows(rows)
 
 
-class CompareAndGate(CliTestCase):
+class CompareAndGate(CliTest):
     """A real small run is the baseline; copies of it are doctored the way a regression would look."""
 
     @classmethod
@@ -437,7 +412,7 @@ class CompareAndGate(CliTestCase):
         self.assertIn("note: machine differs", result.stdout)
 
 
-class KernelMicrobenchmarks(CliTestCase):
+class KernelMicrobenchmarks(CliTest):
     def test_every_variant_is_timed_and_written_as_csv_and_json(self):
         out, js = self.path("k.csv"), self.path("k.json")
         result = run("kernels", "--reps", "1", "--min-time", "0.001", "--pairs", "64", "--out", out, "--json", js)

@@ -6,12 +6,9 @@ file, the row and the column; what the current run's code could have caused is a
 Run through ctest (harness/tests/CMakeLists.txt sets RAYBENCH).
 """
 import json
-import os
-import subprocess
-import tempfile
 import unittest
 
-RAYBENCH = os.environ["RAYBENCH"]
+from cli_testing import CliTestCase, run
 
 # The results schema (harness/src/results/results_csv.cpp), in file order.
 COLUMNS = ["scene", "triangles", "rayset", "query", "rays", "backend", "threads", "build_ms", "build_ms_min",
@@ -23,8 +20,6 @@ COLUMNS = ["scene", "triangles", "rayset", "query", "rays", "backend", "threads"
 METADATA = 'cpu = "test cpu"\nhardware_threads = "2"\ncompiler = "g++"\nflags = "-O2"\nbuild_type = "Release"\nembree = "3.13"\n'
 
 
-def run(*args):
-    return subprocess.run([RAYBENCH, *args], capture_output=True, text=True, timeout=300)
 
 
 def row(scene="terrain", backend="embree", rayset="primary", samples=(9.5, 10.0, 10.5), **changes):
@@ -44,17 +39,7 @@ def suite_rows(**bvh2_changes):
             for r in (row(scene), row(scene, "bvh2", **bvh2_changes))]
 
 
-class GateTestCase(unittest.TestCase):
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory()
-        self.dir = self.tmp.name
-
-    def tearDown(self):
-        self.tmp.cleanup()
-
-    def path(self, *names):
-        return os.path.join(self.dir, *names)
-
+class GateTestCase(CliTestCase):
     def write(self, name, rows, metadata=METADATA, prefix="", newline="\n"):
         """A results CSV (and its .meta.toml) in the test's folder."""
         path = self.path(name + ".csv")
@@ -69,15 +54,6 @@ class GateTestCase(unittest.TestCase):
     def gate(self, baseline, *currents):
         return run("gate", "--baseline", baseline, *[a for c in currents for a in ("--current", c)])
 
-    def assertBadInput(self, result, *fragments):
-        """Exit 2 and one error line on stderr, the last, naming each fragment."""
-        self.assertEqual(result.returncode, 2, result.stdout + result.stderr)
-        lines = result.stderr.strip().splitlines()
-        errors = [line for line in lines if line.startswith("raybench: error: ")]
-        self.assertEqual(len(errors), 1, result.stderr)
-        self.assertEqual(errors[0], lines[-1], result.stderr)
-        for fragment in fragments:
-            self.assertIn(fragment, errors[0])
 
     def assertFails(self, result, *lines):
         """Exit 1, a FAIL line for each of `lines` (a prefix of it), and the summary says FAIL."""

@@ -6,11 +6,10 @@ stderr naming the file (or the manifest's scene), never a crash or a hang.
 Run through ctest (harness/tests/CMakeLists.txt sets RAYBENCH and the mesh folders).
 """
 import os
-import subprocess
-import tempfile
 import unittest
 
-RAYBENCH = os.environ["RAYBENCH"]
+import cli_testing
+from cli_testing import CliTestCase
 MODELS = os.environ.get("RAYBENCH_ASSIMP_MODELS", "/usr/share/assimp/models")
 WUSON = os.path.join(MODELS, "PLY", "Wuson.ply")
 
@@ -21,22 +20,10 @@ SQUARE_VERTICES = b"0 0 0\n1 0 0\n1 1 0\n0 1 0\n"
 
 
 def run(*args, env=None):
-    # A hang would end here with TimeoutExpired: a failure, not a stuck test.
-    return subprocess.run([RAYBENCH, *args], capture_output=True, text=True, timeout=120,
-                          env={**os.environ, **(env or {})})
+    return cli_testing.run(*args, env=env, timeout=120)
 
 
-class LoadersTestCase(unittest.TestCase):
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory()
-        self.dir = self.tmp.name
-
-    def tearDown(self):
-        self.tmp.cleanup()
-
-    def path(self, *names):
-        return os.path.join(self.dir, *names)
-
+class LoadersTestCase(CliTestCase):
     def write(self, name, data):
         with open(self.path(name), "wb") as f:
             f.write(data)
@@ -49,15 +36,6 @@ class LoadersTestCase(unittest.TestCase):
             args += ["--suite", suite]
         return run(*args, env=env)
 
-    def assertBadInput(self, result, *fragments):
-        """Exit 2 and one error line on stderr, the last, naming each fragment (progress lines may precede it)."""
-        self.assertEqual(result.returncode, 2, result.stderr)
-        lines = result.stderr.strip().splitlines()
-        errors = [line for line in lines if line.startswith("raybench: error: ")]
-        self.assertEqual(len(errors), 1, result.stderr)
-        self.assertEqual(errors[0], lines[-1], result.stderr)
-        for fragment in fragments:
-            self.assertIn(fragment, errors[0])
         self.assertFalse(os.path.exists(self.path("rays.npy")))
 
 

@@ -10,6 +10,8 @@
 #include "build_info.h"
 #include "io/error.h"
 #include "raybench/variants.h"
+#include "suite/results_table.h"
+#include "suite/scene_selection.h"
 #include "suite/settings_rules.h"
 #include "test_util.h"
 
@@ -334,6 +336,123 @@ TEST(SettingsRules, SceneNames) {
   for (const char* bad : {"", "../x", "a/b", "a\\b", "a\nb", "a\x01", "a\x7f", "a,b"})
     EXPECT_NE(scene_name_problem(bad), "") << bad;
   EXPECT_EQ(printable("a\nb\x7f"), "a\\x0ab\\x7f");
+}
+
+
+// --- Scene selection (suite/scene_selection.h): one name per scene in a run.
+
+std::string selection_error(const std::vector<std::string>& args, const Suite& suite) {
+  return testing::input_error_of([&] { choose_scenes(args, suite); });
+}
+
+TEST(Suite, ASceneGivenByNameAndAPathWithTheSameStemIsRefusedNamingBoth) {
+  TempDir dir;
+  const Suite suite = load_suite(dir.write("s.toml", "[[scene]]\nname = \"spider\"\npath = \"proc:sphere\"\n"));
+  const std::string mesh = dir.write("spider.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_EQ(selection_error({"spider", mesh}, suite),
+            fmt::format("--scene: spider and {0} both name the scene 'spider' (their rows and ray files would collide): "
+                        "name one of them, e.g. --scene spider_2={0}", mesh));
+  EXPECT_EQ(selection_error({"spider", "spider"}, suite),
+            "--scene: spider and spider both name the scene 'spider' (their rows and ray files would collide): "
+            "give each scene once");
+}
+
+TEST(Suite, APathSceneCanBeNamedOnTheCommandLine) {
+  TempDir dir;
+  const Suite suite = load_suite(dir.write("s.toml", "[[scene]]\nname = \"spider\"\npath = \"proc:sphere\"\n"));
+  const std::string mesh = dir.write("spider.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::vector<SceneChoice> chosen = choose_scenes({"spider", "big_spider=" + mesh, "ball=proc:sphere"}, suite);
+  ASSERT_EQ(chosen.size(), 3u);
+  EXPECT_EQ(chosen[0].name, "spider");
+  EXPECT_NE(chosen[0].entry, nullptr);
+  EXPECT_EQ(chosen[1].name, "big_spider");
+  EXPECT_EQ(chosen[1].path, mesh);
+  EXPECT_EQ(chosen[1].entry, nullptr);
+  EXPECT_EQ(load_chosen_scene(chosen[1]).name, "big_spider");
+  EXPECT_EQ(load_chosen_scene(chosen[2]).name, "ball");
+  // A file whose name holds '=' is a path, not NAME=PATH.
+  const std::string odd = dir.write("a=b.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_EQ(choose_scene(odd, suite).name, "a=b");
+  EXPECT_EQ(choose_scene(odd, suite).path, odd);
+}
+
+TEST(Suite, ANameGivenOnTheCommandLineObeysTheSceneNameRule) {
+  const Suite suite;
+  EXPECT_EQ(selection_error({"bad\nname=proc:sphere"}, suite),
+            "--scene: bad\\x0aname=proc:sphere is read as NAME=PATH (no file has that name), but the name "
+            "'bad\\x0aname' is refused: a scene name must not contain control characters (found 0x0a): it is a field "
+            "of the results CSV");
+  EXPECT_EQ(selection_error({"ball="}, suite), "--scene: ball=: NAME=PATH names no path");
+  EXPECT_EQ(selection_error({"ball=proc:sphere", "ball=proc:terrain_spheres_small"}, suite),
+            "--scene: ball=proc:sphere and ball=proc:terrain_spheres_small both name the scene 'ball' (their rows and "
+            "ray files would collide): name one of them, e.g. --scene ball_2=proc:terrain_spheres_small");
+}
+
+// --- The results table (suite/results_table.h).
+
+ResultRow timed_row(double min, double median, double max) {
+  ResultRow r;
+  r.scene = "bunny";
+  r.triangles = 100;
+  r.rayset = "primary";
+  r.query = "intersect";
+  r.rays = 1000;
+  r.backend = "bvh2";
+  r.mrays_s_min = min;
+  r.mrays_s = median;
+  r.mrays_s_max = max;
+  r.ratio_to_embree = 0.5;
+  r.hit_rate = 0.9;
+  r.agree_hit = 1.0;
+  r.agree_prim = 1.0;
+  return r;
+}
+
+TEST(Suite, TheTableMarksARowWhoseRepetitionsSpreadWidelyAndSaysWhatItMeans) {
+  const std::string table = format_results_table({timed_row(10.0, 14.0, 15.5)});
+  EXPECT_NE(table.find("[10.00 - 15.50]!"), std::string::npos) << table;
+  EXPECT_NE(table.find("! repetitions spread widely (fastest / slowest > 1.5)"), std::string::npos) << table;
+}
+
+TEST(Suite, ARowWithinTheSpreadLimitGetsNoMarkAndNoNote) {
+  for (const ResultRow& row : {timed_row(10.0, 12.0, 15.0), timed_row(0.0, 0.0, 0.0)}) {
+    const std::string table = format_results_table({row});
+    EXPECT_EQ(table.find('!'), std::string::npos) << table;
+    EXPECT_EQ(table.find("spread"), std::string::npos) << table;
+  }
+}
+
+TEST(Suite, TheTableWarnsWhenACameraSeesLittleOfItsScene) {
+  const CameraCoverage little{"bunny", 0.087, "scripts/preview_camera bunny --suite s.toml"};
+  EXPECT_EQ(camera_warning(little), "camera sees little of the scene: 8.7 % of primary rays hit; check it with "
+                                    "scripts/preview_camera bunny --suite s.toml");
+  const std::string table = format_results_table({timed_row(10, 11, 12)}, {little});
+  EXPECT_NE(table.find("  warning: " + camera_warning(little)), std::string::npos) << table;
+  EXPECT_EQ(format_results_table({timed_row(10, 11, 12)}, {{"bunny", 0.25, "x"}}).find("warning"), std::string::npos);
+  EXPECT_EQ(format_results_table({timed_row(10, 11, 12)}, {{"other", 0.0, "x"}}).find("warning"), std::string::npos);
+}
+
+TEST(Suite, TheAccuracyTableShowsTheRefereesVerdictsAsRayCounts) {
+  const AccuracyRow r{.scene = "tiny", .rayset = "diffuse", .query = "intersect", .backend = "bvh2:mt_seed",
+                      .accuracy_class = "epsilon", .rays = 2000, .truth_hits = 0.5, .false_miss = 0.25,
+                      .false_hit = 0.001, .wrong_prim = 0.0015, .self_hits = 0.002, .ulp_p50 = 0.5, .ulp_max = 1024};
+  AccuracyRow occlusion = r;
+  occlusion.rayset = "shadow";
+  occlusion.query = "occluded";
+  occlusion.self_hits = occlusion.ulp_p50 = occlusion.ulp_max = NAN;
+  const std::string table = format_accuracy_table({r, occlusion});
+  EXPECT_NE(table.find("tiny: the exact referee's verdicts (rays)"), std::string::npos) << table;
+  const auto line_of = [&](const std::string& start) {
+    const std::size_t at = table.find(start);
+    return at == std::string::npos ? std::string() : table.substr(at, table.find('\n', at) - at);
+  };
+  EXPECT_EQ(line_of("  rayset"), "  rayset  backend      class      rays    hits  ambig  f_miss  f_hit  wrong   self  "
+                                 "ulp p50  ulp max");
+  EXPECT_EQ(line_of("  diffuse"), "  diffuse bvh2:mt_seed epsilon    2000    1000      0     500      2      3      4  "
+                                  "    0.5     1024");
+  EXPECT_EQ(line_of("  shadow"), "  shadow  bvh2:mt_seed epsilon    2000    1000      0     500      2      -      -  "
+                                 "      -        -");
+  for (const std::string& line : {line_of("  rayset"), line_of("  diffuse")}) EXPECT_LE(line.size(), 100u);
 }
 
 }  // namespace

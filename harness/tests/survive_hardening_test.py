@@ -9,12 +9,12 @@ import glob
 import os
 import signal
 import subprocess
-import tempfile
 import time
 import tomllib
 import unittest
 
-RAYBENCH = os.environ["RAYBENCH"]
+import cli_testing
+from cli_testing import RAYBENCH, CliTestCase
 
 # A closed cube, 12 triangles: the run's third scene, a mesh file.
 CUBE_OBJ = """v -1 -1 -1
@@ -42,7 +42,7 @@ SCENES = ["sphere", "terrain", "cube"]
 
 
 def run(*args):
-    return subprocess.run([RAYBENCH, *args], capture_output=True, text=True, timeout=600)
+    return cli_testing.run(*args, timeout=600)
 
 
 def read_rows(path):
@@ -55,18 +55,11 @@ def read_meta(csv_path):
         return tomllib.load(f)
 
 
-class SurviveTestCase(unittest.TestCase):
+class SurviveTestCase(CliTestCase):
     def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory()
-        self.dir = self.tmp.name
+        super().setUp()
         with open(self.path("cube.obj"), "w") as f:
             f.write(CUBE_OBJ)
-
-    def tearDown(self):
-        self.tmp.cleanup()
-
-    def path(self, *names):
-        return os.path.join(self.dir, *names)
 
     def write_suite(self, repetitions, min_time=0.01):
         """Three small scenes; with 25 repetitions of 0.04 s each takes seconds, so a signal lands mid-run."""
@@ -78,6 +71,21 @@ class SurviveTestCase(unittest.TestCase):
                     '[[scene]]\nname = "terrain"\npath = "proc:terrain_spheres_small"\n'
                     '[[scene]]\nname = "cube"\npath = "cube.obj"\n')
         return suite
+
+    def signal_when(self, process, ready, sig, what):
+        """Sends `sig` to `process` once ready() holds (polled; at most 300 s) and returns its exit status."""
+        try:
+            deadline = time.monotonic() + 300
+            while not ready():
+                self.assertIsNone(process.poll(), f"the process ended before {what}")
+                self.assertLess(time.monotonic(), deadline, f"not {what} after 300 s")
+                time.sleep(0.02)
+            process.send_signal(sig)
+            return process.wait(timeout=60)
+        finally:
+            if process.poll() is None:
+                process.kill()
+                process.wait()
 
     def assertNoTemporaryFiles(self):
         left = [p for pattern in ("*.tmp.*", "*.probe.*", "*.tmp.gbench")
@@ -105,18 +113,8 @@ class Signals(SurviveTestCase):
         with open(self.path("stderr.txt"), "w") as err, open(self.path("stdout.txt"), "w") as stdout:
             process = subprocess.Popen([RAYBENCH, "run", "--suite", self.write_suite(repetitions=25, min_time=0.04), "--out", out,
                                         "--rays-dir", self.path("rays")], stdout=stdout, stderr=err)
-            try:
-                deadline = time.monotonic() + 300
-                while not (os.path.exists(out) and read_rows(out)):
-                    self.assertIsNone(process.poll(), "the run ended before its first scene's rows were written")
-                    self.assertLess(time.monotonic(), deadline, "no rows written after 300 s")
-                    time.sleep(0.02)
-                process.send_signal(sig)
-                returncode = process.wait(timeout=60)
-            finally:
-                if process.poll() is None:
-                    process.kill()
-                    process.wait()
+            returncode = self.signal_when(process, lambda: os.path.exists(out) and read_rows(out), sig,
+                                          "the first scene's rows written")
         with open(self.path("stderr.txt")) as f:
             return out, returncode, f.read().strip().splitlines()
 
@@ -206,18 +204,8 @@ class KernelBenchmarkTemporaryFiles(SurviveTestCase):
         with open(self.path("stderr.txt"), "w") as err:
             process = subprocess.Popen([RAYBENCH, "kernels", "--reps", "1000", "--min-time", "0.01", "--pairs", "64",
                                         "--out", self.path("k.csv"), "--json", js], stdout=subprocess.DEVNULL, stderr=err)
-            try:
-                deadline = time.monotonic() + 300
-                while not os.path.exists(js + ".tmp.gbench"):  # Google Benchmark has opened its output
-                    self.assertIsNone(process.poll(), "kernels ended before timing")
-                    self.assertLess(time.monotonic(), deadline)
-                    time.sleep(0.02)
-                process.send_signal(signal.SIGTERM)
-                returncode = process.wait(timeout=60)
-            finally:
-                if process.poll() is None:
-                    process.kill()
-                    process.wait()
+            returncode = self.signal_when(process, lambda: os.path.exists(js + ".tmp.gbench"), signal.SIGTERM,
+                                          "Google Benchmark's output opened")
         with open(self.path("stderr.txt")) as f:
             last = f.read().strip().splitlines()[-1]
         self.assertEqual(returncode, 143, last)

@@ -118,9 +118,9 @@ inline BBox bbox_from_lanes(__m128 lower, __m128 upper) {
 // as BBox::extend would. With AVX, one vector: the lower corner in the low
 // lanes, the upper corner negated in the high lanes, so one min extends
 // both (max(u, x) is -min(-u, -x), for NaN, which neither takes up, and
-// signed zeros alike): the binning loop's min, max and stores halved,
-// Sibenik's and Conference's builds 10 % faster, the same bins. Without
-// AVX, two SSE vectors.
+// signed zeros alike): the binning loop's min, max and stores halved, the
+// same bins (measured: docs/notes/kernels-builders.md). Without AVX, two
+// SSE vectors.
 struct BoxAccumulator {
 #if defined(__AVX__)
   using Key = __m256;
@@ -162,8 +162,8 @@ struct BoxAccumulator {
 // BBox::extend, so NaN boxes bin as before). One set of bins: even and odd
 // references had filled two sets, merged at the end, so that a run of
 // references in one bin would not wait on its own stores; with the fewer
-// bins of small ranges (bins_for) one set builds 5 % faster (Sibenik, the
-// bunny, Lucy, Conference, the terrain: the same trees).
+// bins of small ranges (bins_for) one set is faster and gives the same trees
+// (measured: docs/notes/kernels-builders.md).
 template <std::size_t MaxBins, typename Ref>
 void bin_all_axes(std::span<const Ref> refs, const float lo[3], const float scale[3], int bins,
                   std::array<std::array<BBox, MaxBins>, 3>& bin_bounds,
@@ -211,8 +211,8 @@ void bin_all_axes(std::span<const Ref> refs, const float lo[3], const float scal
 
 // As bin_all_axes, in chunks binned as parallel tasks, then merged: the
 // top levels' ranges, binned on one thread, held up a small mesh's parallel
-// build (Wuson's 3,732 triangles: 1.6x faster on two threads, Embree's
-// 2.0x). The same bins as one pass: min, max and counts are exact whatever
+// build (measured: docs/notes/kernels-builders.md). The same bins as one
+// pass: min, max and counts are exact whatever
 // the order (a NaN coordinate is never taken up, as in BBox::extend), and
 // the chunks depend on the range's size alone.
 template <std::size_t MaxBins, typename Ref>

@@ -2,7 +2,10 @@
 // Volume Hierarchies", IEEE RT 2007. Subtrees are built in parallel with TBB.
 // The tree's shape and leaf contents depend only on the input; with several
 // threads the nodes' positions in the array may differ between builds, which
-// changes no traversal result.
+// changes no traversal result. NaN boxes bin as BBox::extend takes them (a
+// NaN coordinate is never taken up); coincident centroids and ranges past
+// max_sah_depth are halved, so the depth stays bounded.
+// measured (constants, passes): docs/notes/kernels-builders.md
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -86,8 +89,7 @@ RangeBounds range_bounds(const PrimRef* first, const PrimRef* last) {
 constexpr std::size_t kGrain = 1024;
 
 // Ranges of at least this many references are partitioned in two halves at
-// once (Builder::partition_in_halves). 2^15 and 2^13 measured alike on
-// Conference and Sponza, 2^17 gained half as much.
+// once (Builder::partition_in_halves). measured: docs/notes/kernels-builders.md
 constexpr std::size_t kHalvedPartition = std::size_t{1} << 15;
 
 // Ranges of fewer references are built into one thread's scratch
@@ -135,11 +137,8 @@ class Builder {
   // Builds a range that no task will share into this thread's scratch, then
   // takes all its slots from the tree's array at once and moves it there.
   // Taking every pair from the shared counter sent its cache line back and
-  // forth between the cores: on two threads, that instruction and a read of
-  // bins_ beside it took 11 % of the builder's time (perf, Conference);
-  // with the counter on its own line and ranges built locally, Conference's
-  // BVH2 builds in 42 ms instead of 49 (one thread: 77, unchanged). On one
-  // thread the nodes land where they did, in depth-first order.
+  // forth between the cores (measured: docs/notes/kernels-builders.md). On
+  // one thread the nodes land where they did, in depth-first order.
   void build_locally(std::uint32_t node_index, std::size_t begin, std::size_t end, const RangeBounds& range, int depth) {
     std::unique_ptr<BuildBuffer<Bvh2Node>>& scratch = scratch_.local();
     const std::size_t most = 2 * (end - begin) - 1;  // every leaf one reference
@@ -225,7 +224,7 @@ class Builder {
     // The boxes gather in locals, written out once: gathered in `left` and
     // `right` themselves, they lived in memory, as the swaps' float stores
     // may alias a SIMD vector, and every extend waited on the one before
-    // it through a store and a load (a third of the partition's time).
+    // it through a store and a load (measured: docs/notes/kernels-builders.md).
     RangeBounds l, r;
     for (;;) {
       while (first != last && goes_left(*first)) l.extend(*first++);
@@ -244,10 +243,8 @@ class Builder {
   // halves are partitioned (the same way) as two parallel tasks, then the
   // right side of the first half and the left side of the second trade
   // places, as many as the smaller of them holds. The root's partition alone
-  // took 2.5 of the 41 ms Conference's BVH2 build took on two threads, with
-  // the other thread idle; halved down to 32,768 references, the build takes
-  // 39 ms (Sponza 32.6 -> 30.9), and 2 % less on one thread (the halves
-  // partition in cache). The halves depend on the range's size alone, so
+  // left the other thread idle (measured: docs/notes/kernels-builders.md).
+  // The halves depend on the range's size alone, so
   // the references' order, and the tree, are the same on any thread count;
   // each side holds the references it held, in another order.
   static PrimRef* partition_in_halves(PrimRef* first, PrimRef* last, const BBox& centroids, const ObjectSplit& split,
@@ -274,8 +271,8 @@ class Builder {
 
   // Fewer bins for small ranges, where evaluating 16 bins costs more than
   // binning the few triangles: one bin per two triangles, at least 8
-  // (Bvh2BuildOptions::bin_count at most). Measured on Sponza: the build 9 %
-  // faster, the SAH cost of the tree unchanged to 0.05 %.
+  // (Bvh2BuildOptions::bin_count at most); the tree's SAH cost is
+  // unchanged (measured: docs/notes/kernels-builders.md).
   int bins_for(std::size_t count) const {
     return std::min(bins_, std::max(8, static_cast<int>(std::min<std::size_t>(count / 2, kMaxBins))));
   }

@@ -2,12 +2,10 @@
 // before a parallel pass fills it (private to kernels/src).
 //
 // Why: the first touch of a huge page (raybench/bvh/huge_pages.h) makes the
-// kernel zero all 2 MiB of it, about 0.15 ms here, while any other thread
-// touching the same page waits. A parallel fill starts its second thread
-// half-way through the array, often in the first thread's page, so the
-// faults ran one after the other: Sibenik's packs (two huge pages) took
-// 0.4 ms longer to fill than the same fill into touched memory, on one
-// thread and on two alike.
+// kernel zero all 2 MiB of it, while any other thread touching the same
+// page waits. A parallel fill starts its second thread half-way through the
+// array, often in the first thread's page, so the faults ran one after the
+// other (measured: docs/notes/kernels-builders.md).
 #pragma once
 
 #include <algorithm>

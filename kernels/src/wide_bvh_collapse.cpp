@@ -1,3 +1,15 @@
+// The collapse of a Bvh2 into a WideBvh<W> (W = 8 or 4), collapse_bvh2 in
+// raybench/bvh/wide_bvh.h: the wide tree of least SAH cost among all whose
+// nodes are cuts of the BVH2, by the dynamic programme of Ylitie, Karras &
+// Laine, "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide
+// BVHs", HPG 2017 (section 4.1); each node's per-octant child orders and
+// any-hit lane order; the triangle packs its leaf test needs.
+// Guarantee: every triangle of the BVH2 is in exactly one pack; the result
+// is the same bytes for any thread count (each task writes only its own
+// slots); NaN or infinite boxes and costs (a broken mesh, coordinates past
+// about 3.7e18) still give a valid tree, never a pack of more than W.
+// measured (optimal against greedy, costs tried, build time):
+// docs/notes/kernels-collapse.md
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -40,8 +52,7 @@ void order_children(WideNode<W>& node) {
   // The same keys and order, W lanes at a time: each lane's rank in the
   // order (keys greater, then equal keys in earlier lanes) is a popcount of
   // two lane comparisons. The insertion sort's data-dependent branches
-  // mispredicted so often that ordering a node's 8 octants took 0.9 us,
-  // half of Sponza's collapse.
+  // mispredicted (measured: docs/notes/kernels-collapse.md).
   using Lanes = simd::FloatLanes<W>;
   const Lanes inf = Lanes::set1(std::numeric_limits<float>::infinity());
   Lanes centre2[3];
@@ -107,14 +118,10 @@ void order_children(WideNode<W>& node) {
 // its triangles, if at most W, or as a wide node of its own), or n's two
 // children sharing the k slots. Any BVH2 subtree of at most W triangles may
 // become a pack, so the BVH2 is best built with small leaves (the backends'
-// quality builds use leaf_granularity 1) and the collapse gathers them. The
-// greedy collapse (open the largest child until W; Wald et al. RT 2008) left
-// Sponza's nodes 4.2 of 8 children full, this 6.7, for 4-10 % more rays/s.
-// A pack test costed at 0.7, 1.5 or 2 node visits instead of 1 (bvh8 and
-// bvh8:sbvh:reinsert, four scenes, every ray kind, interleaved) measured
-// within noise of 1. Packs of at most 4 triangles stored 4 wide (half the
-// bytes, tested with SSE; 40-50 % of the quality builds' packs) measured no
-// faster either (geometric mean +0.1 %, Lucy's quality builds slower).
+// quality builds use leaf_granularity 1) and the collapse gathers them. It
+// fills nodes fuller than the greedy collapse (open the largest child until
+// W; Wald et al., RT 2008). measured, with the costs tried and dropped:
+// docs/notes/kernels-collapse.md
 template <int W>
 class Collapser {
  public:
@@ -135,7 +142,7 @@ class Collapser {
       choose_slots();
       // Room for the most there can be, so plan(), serial, never moves them:
       // every wide node is a distinct inner BVH2 node, every pack holds at
-      // least one BVH2 leaf. Growing them took a fifth of Conference's plan.
+      // least one BVH2 leaf (measured: docs/notes/kernels-collapse.md).
       plans_.reserve(bvh2_.nodes.size() / 2);
       pack_roots_.reserve(bvh2_.nodes.size() / 2 + 1);
       plan(0, 0);
@@ -153,8 +160,7 @@ class Collapser {
     bvh2_build::fault_in_parallel(std::span(out_.edge_packs));
     bvh2_build::fault_in_parallel(std::span(out_.vertex_packs));
     // Small grains: a small mesh's hundred nodes and few hundred packs are
-    // filled on both threads too (Wuson's two-thread build 6 % faster than
-    // with grains of 1024, which left them to one thread).
+    // filled on both threads too (measured: docs/notes/kernels-collapse.md).
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, plans_.size(), 64), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) fill_node(i);
     });
@@ -401,10 +407,8 @@ class Collapser {
   // BVH2 levels above parallel_depth_ are evaluated as parallel tasks: at
   // most 2^7 of them, in a balanced tree of kTaskNodes / 2 to kTaskNodes
   // nodes each (or larger, past 2^7); trees of fewer than kTaskNodes nodes
-  // stay serial. At 2048 Wuson's 3,732 triangles were collapsed on one
-  // thread, which single builds had measured faster; timed as the mean of
-  // repeated builds (build_timing.h), Wuson's two-thread build is 4 % faster
-  // at 256, with the builder's smaller grain (bvh2_builder.cpp).
+  // stay serial; 256 lets a small mesh use both threads, with the builder's
+  // smaller grain (bvh2_builder.cpp; measured: docs/notes/kernels-collapse.md).
   static constexpr std::size_t kTaskNodes = 256;
   const int parallel_depth_ =
       std::min(7, static_cast<int>(std::bit_width(bvh2_.nodes.size() / kTaskNodes)));

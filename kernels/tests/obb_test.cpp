@@ -1,5 +1,5 @@
 // Specification of the ray-OBB tests: prim/obb_eigen.h (raybench's
-// semantics) and prim/obb_seed.h (seed 004 as written, whose faults are pinned
+// semantics) and prim/obb_seed.h (the ray-OBB seed note as written, whose faults are pinned
 // as KnownFailure_* tests).
 //
 // Semantics (obb_eigen.h): the box is closed and solid; a hit is a point of
@@ -273,7 +273,7 @@ TEST(Obb, NonFiniteAndEmptyInputMisses) {
 }
 
 // ---------------------------------------------------------------------------
-// obb_seed: seed 004 as written. What it gets right, then its faults, each
+// obb_seed: the ray-OBB seed note as written. What it gets right, then its faults, each
 // beside obb's answer on the same input.
 
 TEST(ObbSeed, HitsAndMissesAxisAlignedAndRotatedBoxes) {

@@ -301,7 +301,7 @@ TEST(SphereQuadratic, KnownFailure_MissOneUlpOutsideTangentHits) {
 }
 
 // ---------------------------------------------------------------------------
-// sphere_seed: seed 003 as written. Its own semantics first, then its faults,
+// sphere_seed: the ray-sphere seed note (goteet's geometric test) as written. Its own semantics first, then its faults,
 // each beside the fixed variant's answer on the same input.
 
 TEST(SphereSeed, HitReportsBothRootsForAUnitDirection) {

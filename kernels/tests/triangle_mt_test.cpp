@@ -60,7 +60,7 @@ TEST(MollerTrumbore, IntervalIsOpenAtTnearAndClosedAtTfar) {
 }
 
 TEST(MollerTrumbore, TriangleBehindOriginMisses) {
-  // Seed 002 never checks t >= 0 and reports this with t = -1.
+  // The Möller–Trumbore seed note never checks t >= 0 and reports this with t = -1.
   Ray r = down_from(0.25f, 0.25f, -1.0f);
   EXPECT_FALSE(hits(r, kUnit));
 }
@@ -81,7 +81,7 @@ TEST(MollerTrumbore, DegenerateTrianglesMiss) {
 
 TEST(MollerTrumbore, SmallUnitMeshesAreNotHidden) {
   // Bunny scale: legs of 5e-3 give det = 2.5e-5 with a unit direction, which
-  // seed 002's `det < 1e-4` rejects. Without the epsilon it hits.
+  // the seed note's `det < 1e-4` rejects. Without the epsilon it hits.
   const Triangle tiny{{0, 0, 0}, {5e-3f, 0, 0}, {0, 5e-3f, 0}};
   TriangleHit h;
   ASSERT_TRUE(hits(down_from(1e-3f, 1e-3f), tiny, &h));

@@ -1,5 +1,5 @@
 // Specification shared by every ray-triangle test in raybench/variants.h, and
-// the known failures of the seed-faithful one (seed 002) next to the variants
+// the known failures of the seed-faithful one (the Möller–Trumbore seed note, a Chinese blog post deriving it by Cramer's rule) next to the variants
 // that get the same cases right. Known answers are worked by hand on the unit
 // right triangle v0 = (0,0,0), v1 = (1,0,0), v2 = (0,1,0) in the plane z = 0.
 #include <cmath>
@@ -311,7 +311,7 @@ TEST(MollerTrumboreEdges, KnownFailure_ItsFloatNormalLetsRaysHitCollinearTriangl
   RecordProperty("mt_edges_hits_of_4000_rays_at_a_collinear_triangle", edge_hits);
 }
 
-// --- Seed 002 as written: where it breaks, and the fixed variant beside it ----
+// --- The Möller–Trumbore seed note as written: where it breaks, and the fixed variant beside it ----
 
 TEST(MollerTrumboreSeed, AgreesWithTheFixedVariantOnOrdinaryRays) {
   TriangleHit seed, fixed;

@@ -26,6 +26,7 @@
 #include "scene/procedural.h"
 #include "rays/rayset.h"
 #include "scene/scene.h"
+#include "suite/scene_selection.h"
 #include "suite/settings_rules.h"
 #include "suite/suite.h"
 #include "suite/suite_run.h"
@@ -158,7 +159,8 @@ int run(int argc, char** argv) {
   CLI::App* run_cmd = app.add_subcommand("run", "Run a benchmark suite: every scene x ray set x backend x thread count");
   run_cmd->add_option("--suite", suite_path, "Suite manifest (TOML)")->capture_default_str();
   run_cmd->add_option("--scene,-s", run_options.scenes,
-                      "Scenes to run: names from the suite, mesh paths, or proc:<name> (default: every available suite scene)")
+                      "Scenes to run: names from the suite, mesh paths, proc:<name>, or NAME=PATH to name a mesh (default: every "
+                      "available suite scene)")
       ->delimiter(',');
   run_cmd->add_option("--rayset,-r", run_raysets, fmt::format("Ray sets: {} (default: the suite's)", fmt::join(rayset_kind_names(), ", ")))
       ->delimiter(',');
@@ -281,6 +283,13 @@ int run(int argc, char** argv) {
   std::string scenes_suite = kDefaultSuite;
   CLI::App* scenes_cmd = app.add_subcommand("scenes", "List the suite's scenes and the procedural scenes");
   scenes_cmd->add_option("--suite", scenes_suite, "Suite manifest")->capture_default_str();
+  bool scenes_bounds = false;
+  std::vector<std::string> scenes_names;
+  scenes_cmd->add_flag("--bounds", scenes_bounds,
+                       "Load each scene and print its triangle count, bounds and the camera its primary rays use");
+  scenes_cmd->add_option("--scene,-s", scenes_names,
+                         "With --bounds: only these scenes (names from the suite, mesh paths, proc:<name>, NAME=PATH)")
+      ->delimiter(',');
 
   try {
     app.parse(argc, argv);
@@ -373,6 +382,25 @@ int run(int argc, char** argv) {
     for (const BackendInfo& b : list_backends()) fmt::print("{:<20} {}\n", b.name, b.description);
     return 0;
   }
+  if (*scenes_cmd && (scenes_bounds || !scenes_names.empty())) {
+    const Suite suite = load_suite(scenes_suite);
+    std::vector<SceneChoice> chosen = choose_scenes(scenes_names, suite);
+    if (scenes_names.empty())
+      for (const SuiteScene& s : suite.scenes)
+        if (s.available()) chosen.push_back(choose_scene(s.name, suite));
+    for (const SceneChoice& c : chosen) {
+      const Scene scene = load_chosen_scene(c);
+      const BBox b = scene.bounds();
+      const bool suite_camera = c.entry && c.entry->camera;
+      const Camera cam = suite_camera ? *c.entry->camera : RayGenerator(scene).default_camera();
+      const auto v = [](Vec3f p) { return fmt::format("({:.6g}, {:.6g}, {:.6g})", p.x, p.y, p.z); };
+      fmt::print("{}: {} triangles\n  bounds {} - {}, size {}\n  camera ({}) position {} look_at {} up {} fov {:.6g}\n",
+                 printable(scene.name), scene.triangles.size(), v(b.lower), v(b.upper), v(b.upper - b.lower),
+                 suite_camera ? "the suite's" : "default: frames the bounds from outside", v(cam.position),
+                 v(cam.look_at), v(cam.up), cam.fov_degrees);
+    }
+    return 0;
+  }
   if (*scenes_cmd || (*run_cmd && list_only)) {
     const Suite suite = load_suite(*scenes_cmd ? scenes_suite : suite_path);
     fmt::print("suite {}:\n", suite.path);
@@ -409,19 +437,6 @@ int run(int argc, char** argv) {
     check_output_folder("--rays-dir", run_options.rays_dir);
 
     run_options.suite = load_suite(suite_path);
-    for (const std::string& name : run_options.scenes) {
-      // A scene given by path is named after its file's stem (scene.h), and
-      // that name goes into file names and the CSV like a manifest's: the
-      // same rule applies. Refused, not rewritten: a rewritten name could
-      // collide with another scene's.
-      if (run_options.suite.find(name) || name.rfind(kProceduralPrefix, 0) == 0) continue;
-      const std::string stem = std::filesystem::path(name).stem().string();
-      if (const std::string problem = scene_name_problem(stem); !problem.empty())
-        throw InputError("--scene", fmt::format("{}: its file name gives the scene name '{}', but {}; name the scene in "
-                                                "a suite manifest ([[scene]] name = \"...\", path = \"...\") and run it "
-                                                "with --suite",
-                                                printable(name), printable(stem), problem));
-    }
     SuiteSettings& s = run_options.settings;
     s = run_options.suite.settings;
     if (!run_raysets.empty()) s.raysets = run_raysets;
@@ -430,9 +445,11 @@ int run(int argc, char** argv) {
     for (const auto& apply : overrides) apply(s);
     run_options.interleave = !no_interleave;
     run_options.command_line = command_line(argc, argv);
-    const std::vector<ResultRow> rows = run_suite(run_options);
-    std::cout << format_results_table(rows) << std::endl;
-    fmt::print("results: {} ({} rows), metadata: {}\n", run_options.out_csv, rows.size(),
+    const RunResults results = run_suite(run_options);
+    std::cout << format_results_table(results.rows, results.cameras);
+    if (!run_options.accuracy_csv.empty()) std::cout << format_accuracy_table(results.accuracy);
+    std::cout << std::endl;
+    fmt::print("results: {} ({} rows), metadata: {}\n", run_options.out_csv, results.rows.size(),
                metadata_path_for(run_options.out_csv));
     return 0;
   }

@@ -1,3 +1,6 @@
+// write_file_atomically (io/atomic_file.h): a temporary file beside the
+// target, renamed into place only when written completely; the temporary is
+// removed on failure and on SIGINT/SIGTERM (io/interrupt.h).
 #include "io/atomic_file.h"
 
 #include <cerrno>

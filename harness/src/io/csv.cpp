@@ -1,3 +1,6 @@
+// Writing and reading raybench's CSV files (io/csv.h): RFC 4180 quoting, a
+// BOM and CRLF tolerated on reading; a ragged line or a missing column is an
+// InputError naming the file and the line.
 #include "io/csv.h"
 
 #include <algorithm>

@@ -1,5 +1,9 @@
 // CSV fields as every raybench CSV writes and reads them (RFC 4180 quoting,
 // NaN written as an empty field meaning "not applicable").
+// Guarantee: a file that cannot be read as a table (missing column, ragged
+// line) is an InputError naming the file and the line. Reading is line by
+// line: a quoted field holding a newline, which csv_text writes, is not
+// read back as one field.
 #pragma once
 
 #include <map>

@@ -1,3 +1,6 @@
+// The boundary check of every file raybench reads or writes (io/input_file.h):
+// anything but a regular file (or a link to one) is refused by name before
+// it is opened.
 #include "io/input_file.h"
 
 #include <filesystem>

@@ -1,3 +1,6 @@
+// The SIGINT/SIGTERM handler that removes half-written results
+// (io/interrupt.h): fixed storage for the paths (the handler may not
+// allocate), async-signal-safe calls only.
 #include "io/interrupt.h"
 
 #include <algorithm>

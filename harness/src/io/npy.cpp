@@ -1,3 +1,7 @@
+// Reading and writing NumPy .npy files (io/npy.h): the header parsed as
+// numpy writes it and nothing else, every mismatch of magic, dtype, shape,
+// order or body length an InputError naming the file; files are written
+// atomically (io/atomic_file.h).
 #include "io/npy.h"
 
 #include <charconv>

@@ -1,3 +1,6 @@
+// Per-ray agreement of a backend with a reference (measure/agreement.h):
+// hit/miss, triangle and t compared ray by ray; a different triangle at the
+// same float t, or at the same exact t, is counted as a tie as well.
 #include "measure/agreement.h"
 
 #include <algorithm>

@@ -1,4 +1,8 @@
-// Per-ray agreement of a backend with a reference (Embree's default build).
+// Per-ray agreement of a backend with a reference (Embree's default build):
+// the "agree" columns of a run. disagreements() counts the rays that differ
+// on hit/miss and those where both hit different triangles; of the latter,
+// prim_ties counts those at the same t (float, or exact given the scene),
+// for a reader to discount.
 #pragma once
 
 #include <cstddef>
@@ -38,8 +42,7 @@ double nearest_rank_percentile(std::vector<double>& values, double p);
 // by Hit::prim), the same exact t (same_exact_t, the referee's arithmetic).
 // Exact ties are what "not counting ties" means: two tracers rounding t
 // their own ways rarely return the same float for coincident triangles
-// (bvh8:watertight against Embree, Sibenik's diffuse rays: 311 ties
-// at the same float t, 443 more at the same exact t, none nearer or farther).
+// (observed: docs/notes/harness-measurement.md).
 Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference, std::span<const Ray> rays = {},
                        std::span<const Triangle> triangles = {});
 Agreement compare_occlusion(std::span<const std::uint8_t> tested, std::span<const std::uint8_t> reference);

@@ -4,13 +4,15 @@
 // once, in turn. A noisy neighbour then slows all backends of a round alike,
 // so the ratio of two backends' medians stays fair; timed back to back, one
 // backend's builds could all fall into a quiet second and another's into a
-// busy one (the scorecard saw the same default build read 25.8 and 33.1 ms).
+// busy one.
 // A build shorter than the minimum time is repeated within its round, as
 // often as its warm-up build says fits (at most kMaxBuildsPerSample times),
 // and the round's sample is their mean, as a trace repetition lasts at least
 // --min-time: a single sub-millisecond build reads the timer's and the
-// scheduler's noise (the small meshes' build ratios moved by 10-20 % between
-// rounds, and flipped the scorecard's build targets from run to run).
+// scheduler's noise.
+// Guarantee: every backend is timed in every round, in the same order; a
+// sample is the mean of at least one and at most kMaxBuildsPerSample builds.
+// observed: docs/notes/harness-measurement.md
 #pragma once
 
 #include <span>

@@ -1,3 +1,5 @@
+// The Google Benchmark glue (measure/gbench.h): one initialisation per
+// process and a reporter that keeps every repetition's raw sample.
 #include "measure/gbench.h"
 
 #include <algorithm>

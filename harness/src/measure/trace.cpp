@@ -1,3 +1,6 @@
+// TraceExecutor (measure/trace.h): chunks of at most kChunk rays, one
+// virtual call each, on the workers of one TBB arena; every ray is traced
+// once and its answer written to its own slot.
 #include "measure/trace.h"
 
 #include <tbb/blocked_range.h>

@@ -1,6 +1,8 @@
 // Tracing a whole ray set with a backend on N threads. Every backend is
 // driven the same way: the rays are cut into fixed chunks, handed to TBB
 // workers of one arena, and each chunk is one virtual call into the backend.
+// Guarantee: every ray is traced exactly once and its answer written to the
+// same index of the output; no more than `threads` threads trace.
 #pragma once
 
 #include <functional>

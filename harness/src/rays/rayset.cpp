@@ -1,3 +1,9 @@
+// Ray-set generation (rays/rayset.h): every kind, from camera rays to the
+// extreme-case sets of ../shared/EXTREMES.md (case numbers G.. given at
+// each), computed in double from counter-based random numbers
+// (scene/random.h) and rounded to float, so a ray set depends only on
+// (scene, kind, count, seed, camera, light), never on the thread count
+// (across machines, as far as their libm's sin and cos agree).
 #include "rays/rayset.h"
 
 #include <algorithm>

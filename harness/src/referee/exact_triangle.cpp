@@ -11,6 +11,11 @@
 namespace raybench {
 namespace {
 
+// The file: the exact ray-triangle judgement of referee/exact_triangle.h,
+// filtered: each sign and t is first taken from interval arithmetic, and
+// computed in GMP rationals (CGAL::Gmpq) only when the interval cannot
+// decide (or for the nearest double and for ties), so every decision is
+// exact and the common case fast.
 // Interval_nt<false> assumes the FPU rounds upwards; Protect_FPU_rounding
 // sets that for the scope of each judgement and restores it after.
 using Interval = CGAL::Interval_nt<false>;

@@ -1,3 +1,7 @@
+// The referee (referee/referee.h): our BVH2 walked with a conservative box
+// test carried out in double (SlabRobustDouble below), every candidate
+// triangle judged exactly (referee/exact_triangle.h), the nearest exact t
+// winning and exact ties reported.
 #include "referee/referee.h"
 
 #include <algorithm>

@@ -1,3 +1,7 @@
+// Running work in a forked child with a deadline (scene/isolated_call.h):
+// the parent polls the child's pipes until the deadline, kills it with
+// SIGKILL past it, and always reaps it; a crash, a non-zero exit or a missed
+// deadline becomes IsolatedCallFailed with what the child printed last.
 #include "scene/isolated_call.h"
 
 #include <algorithm>

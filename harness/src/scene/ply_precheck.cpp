@@ -1,3 +1,6 @@
+// The PLY header pre-check (scene/ply_precheck.h): splits lines exactly as
+// assimp 5.2's IOStreamBuffer does, so that it refuses the headers assimp
+// would loop on and no others.
 #include "scene/ply_precheck.h"
 
 namespace raybench {

@@ -1,3 +1,9 @@
+// The procedural scenes "proc:<name>" (scene/procedural.h): closed-form
+// shapes and counter-based random numbers (scene/random.h), so a scene is
+// the same triangles on every run and thread count (across machines, as far
+// as their libm's sin and cos agree). The extreme-case scenes follow the
+// catalogue ../shared/EXTREMES.md (its case numbers G.. are given where they
+// are made).
 #include "scene/procedural.h"
 
 #include <cmath>

@@ -1,3 +1,6 @@
+// Scene helpers (scene/scene.h): its bounds, and the coordinate check that
+// refuses a vertex that is not finite or beyond kMaxSceneCoordinate, naming
+// the triangle.
 #include "scene/scene.h"
 
 #include <cmath>

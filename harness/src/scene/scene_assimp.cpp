@@ -8,14 +8,10 @@
 // naming the file. The child uses assimp, malloc and write(2) only, no TBB.
 //
 // The deadline is RAYBENCH_LOAD_TIMEOUT seconds (any number in (0, 86400],
-// e.g. 0.5), 120 by default. Lucy, the largest shared mesh (100k
-// triangles), loads in about 0.1 s even on a busy 2-core machine; at
-// Sponza's rate (1.5M triangles/s there) Stanford's full 28M-triangle Lucy
-// would take about 20 s, so 120 s leaves room for any real mesh, and a file
-// that hangs assimp costs two minutes, not forever.
-//
-// What the isolation costs in load time (fork, the triangles copied once
-// through the pipe): measured for issue 28, in README.md, "Reliability".
+// e.g. 0.5), 120 by default: room for any real mesh (a 28M-triangle one
+// would take about 20 s), and a file that hangs assimp costs two minutes,
+// not forever. measured: docs/notes/harness-measurement.md; what the
+// isolation costs in load time: docs/reliability.md.
 #include <algorithm>
 #include <cerrno>
 #include <chrono>

@@ -28,6 +28,8 @@
 #include "rays/rayset.h"
 #include "referee/referee.h"
 #include "scene/scene.h"
+#include "suite/results_table.h"
+#include "suite/scene_selection.h"
 #include "suite/settings_rules.h"
 #include "measure/trace.h"
 
@@ -37,7 +39,7 @@ namespace {
 void progress(const std::string& line) { std::cerr << "raybench: " << line << std::endl; }
 
 struct LoadedScene {
-  const SuiteScene* entry = nullptr;  // null for a scene given by path
+  SceneChoice choice;  // choice.entry: null for a scene given by path
   Scene scene;
 };
 
@@ -77,16 +79,10 @@ std::vector<Ray> obtain_rays(const RayGenerator& generator, const Scene& scene, 
   return rays;
 }
 
-LoadedScene load(const RunOptions& options, const std::string& name_or_path) {
-  LoadedScene loaded;
-  loaded.entry = options.suite.find(name_or_path);
-  loaded.scene = loaded.entry ? load_suite_scene(*loaded.entry) : load_scene(name_or_path);
-  return loaded;
-}
-
 struct SceneResults {
   std::vector<ResultRow> rows;
   std::vector<AccuracyRow> accuracy;  // runs with RunOptions::accuracy_csv only
+  std::optional<CameraCoverage> camera;  // runs with the primary ray set
 };
 
 // One scene, scene `index` of `count`: its ray sets (made or reused), the
@@ -94,7 +90,7 @@ struct SceneResults {
 // reference, and the timing of every case. No rows when no ray set applies.
 SceneResults measure_scene(const RunOptions& options, const LoadedScene& loaded, std::size_t index, std::size_t count) {
   const Scene& scene = loaded.scene;
-  const SuiteScene* entry = loaded.entry;
+  const SuiteScene* entry = loaded.choice.entry;
   const SuiteSettings& settings = options.settings;
   SceneResults results;
   progress(fmt::format("[{}/{}] {}: ray sets", index + 1, count, scene.name));
@@ -163,6 +159,16 @@ SceneResults measure_scene(const RunOptions& options, const LoadedScene& loaded,
       }
     }
     reference.reset();
+    // What the camera sees, once per scene: Embree's primary hits.
+    for (std::size_t r = 0; r < raysets.size() && !results.camera; ++r) {
+      if (raysets[r].kind != RaySetKind::kPrimary || ref_hits[r].empty()) continue;
+      const auto hit = std::count_if(ref_hits[r].begin(), ref_hits[r].end(), [](const Hit& h) { return h.hit(); });
+      results.camera = CameraCoverage{scene.name, static_cast<double>(hit) / static_cast<double>(ref_hits[r].size()),
+                                      entry ? fmt::format("scripts/preview_camera {} --suite {}", scene.name,
+                                                          options.suite.path)
+                                            : fmt::format("scripts/preview_camera {}", loaded.choice.path)};
+      if (sees_little(*results.camera)) progress("  warning: " + camera_warning(*results.camera));
+    }
 
     std::vector<Backend*> built;
     for (const std::string& backend_name : settings.backends) {
@@ -329,7 +335,7 @@ std::size_t write_finished_scenes(const RunOptions& options, const Metadata& run
 
 }  // namespace
 
-std::vector<ResultRow> run_suite(const RunOptions& options) {
+RunResults run_suite(const RunOptions& options) {
   const SuiteSettings& settings = options.settings;
   // Validate everything cheap before spending minutes.
   for (const std::string& k : settings.raysets) parse_rayset_kind(k);
@@ -338,20 +344,20 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
   if (settings.repetitions < 1) throw InputError("", "--reps must be at least 1");
   check_writable(options.out_csv);
   if (!options.accuracy_csv.empty()) check_writable(options.accuracy_csv);
-  std::vector<std::string> names = options.scenes;
-  if (names.empty()) {
+  std::vector<SceneChoice> chosen = choose_scenes(options.scenes, options.suite);
+  if (options.scenes.empty()) {
     for (const SuiteScene& s : options.suite.scenes) {
-      if (s.available()) names.push_back(s.name);
+      if (s.available()) chosen.push_back(choose_scene(s.name, options.suite));
       else if (!s.optional) throw InputError(options.suite.path, fmt::format("scene '{}': {} not found (add optional = true to skip it when absent)", s.name, s.path));
       else progress(fmt::format("skipping scene '{}': {} not found", s.name, s.path));
     }
-    if (names.empty()) throw InputError(options.suite.path, "no scene of the suite is available");
+    if (chosen.empty()) throw InputError(options.suite.path, "no scene of the suite is available");
   }
 
   std::vector<LoadedScene> scenes;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    progress(fmt::format("[{}/{}] loading {}", i + 1, names.size(), names[i]));
-    scenes.push_back(load(options, names[i]));
+  for (std::size_t i = 0; i < chosen.size(); ++i) {
+    progress(fmt::format("[{}/{}] loading {}", i + 1, chosen.size(), chosen[i].arg));
+    scenes.push_back({chosen[i], load_chosen_scene(chosen[i])});
     const Scene& s = scenes.back().scene;
     progress(fmt::format("  {} triangles{}", s.triangles.size(),
                          s.skipped_points + s.skipped_lines
@@ -379,8 +385,9 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
 
   initialize_google_benchmark(
       {fmt::format("--benchmark_enable_random_interleaving={}", options.interleave ? "true" : "false")});
-  std::vector<ResultRow> rows;
-  std::vector<AccuracyRow> accuracy_rows;
+  RunResults results;
+  std::vector<ResultRow>& rows = results.rows;
+  std::vector<AccuracyRow>& accuracy_rows = results.accuracy;
   std::size_t finished = 0;  // scenes whose rows are on disk
   set_interrupt_message(fmt::format("no scene had finished; nothing written to {}", options.out_csv));
   try {
@@ -388,6 +395,7 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
       SceneResults scene = measure_scene(options, scenes[si], si, scenes.size());
       rows.insert(rows.end(), scene.rows.begin(), scene.rows.end());
       accuracy_rows.insert(accuracy_rows.end(), scene.accuracy.begin(), scene.accuracy.end());
+      if (scene.camera) results.cameras.push_back(*scene.camera);
       finished = write_finished_scenes(options, run_description, rows, accuracy_rows, si + 1, scenes.size());
     }
   } catch (const std::exception& e) {
@@ -400,34 +408,7 @@ std::vector<ResultRow> run_suite(const RunOptions& options) {
   }
   if (!options.accuracy_csv.empty())
     progress(fmt::format("accuracy: {} ({} rows)", options.accuracy_csv, accuracy_rows.size()));
-  return rows;
-}
-
-std::string format_results_table(const std::vector<ResultRow>& rows) {
-  // Column widths follow the longest ray-set and backend names in the run.
-  std::size_t rayset_width = 6, backend_width = 7;
-  for (const ResultRow& r : rows) {
-    rayset_width = std::max(rayset_width, r.rayset.size());
-    backend_width = std::max(backend_width, r.backend.size());
-  }
-  const auto percent = [](double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.3f}%", 100.0 * v); };
-  std::string out, scene;
-  for (const ResultRow& r : rows) {
-    if (r.scene != scene) {
-      scene = r.scene;
-      out += fmt::format("\n{} ({} triangles)\n", r.scene, r.triangles);
-      out += fmt::format("  {:<{}} {:<{}} {:>3} {:>9} {:>19} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>7}\n", "rayset",
-                         rayset_width, "backend", backend_width, "thr", "Mrays/s", "[min - max]", "x embree", "hit", "agree",
-                         "same tri", "build ms", "MiB", "leaks");
-    }
-    out += fmt::format("  {:<{}} {:<{}} {:>3} {:>9.2f} {:>19} {:>8} {:>8} {:>9} {:>9} {:>9.1f} {:>9.1f} {:>7}\n", r.rayset,
-                       rayset_width, r.backend, backend_width, r.threads, r.mrays_s,
-                       fmt::format("[{:.2f} - {:.2f}]", r.mrays_s_min, r.mrays_s_max),
-                       r.ratio_to_embree > 0 ? fmt::format("{:.2f}", r.ratio_to_embree) : "-",
-                       fmt::format("{:.1f}%", 100.0 * r.hit_rate), percent(r.agree_hit), percent(r.agree_prim), r.build_ms,
-                       r.memory_bytes / 1048576.0, r.leaks ? std::to_string(*r.leaks) : "-");
-  }
-  return out;
+  return results;
 }
 
 }  // namespace raybench

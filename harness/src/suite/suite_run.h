@@ -6,7 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "accuracy/accuracy_csv.h"
 #include "results/results_csv.h"
+#include "suite/results_table.h"
 #include "suite/suite.h"
 
 namespace raybench {
@@ -14,7 +16,7 @@ namespace raybench {
 struct RunOptions {
   Suite suite;
   SuiteSettings settings;            // the suite's defaults with command-line overrides applied
-  std::vector<std::string> scenes;   // suite scene names or mesh paths; empty: every available suite scene
+  std::vector<std::string> scenes;   // --scene arguments (scene_selection.h); empty: every available suite scene
   std::string out_csv;
   std::string rays_dir;              // where ray sets are stored and reused
   bool raysets_from_command_line = false;  // settings.raysets then override each scene's own list
@@ -30,11 +32,16 @@ struct RunOptions {
 // against (not the exact referee, which is the backend named "reference").
 inline constexpr const char* kReferenceBackend = "embree";
 
-// Runs the suite and writes the CSV, its .meta.toml and a table on stdout.
-// Throws InputError on bad input, before any benchmark runs where possible.
-std::vector<ResultRow> run_suite(const RunOptions& options);
+// What a run measured: its rows as written, and what each scene's camera saw.
+struct RunResults {
+  std::vector<ResultRow> rows;
+  std::vector<AccuracyRow> accuracy;    // --accuracy runs
+  std::vector<CameraCoverage> cameras;  // scenes traced with the primary ray set
+};
 
-// The aligned per-scene table printed at the end of a run.
-std::string format_results_table(const std::vector<ResultRow>& rows);
+// Runs the suite and writes the CSV (and the accuracy CSV) with metadata;
+// the tables (results_table.h) are the caller's to print. Throws InputError
+// on bad input, before any benchmark runs where possible.
+RunResults run_suite(const RunOptions& options);
 
 }  // namespace raybench

@@ -48,9 +48,9 @@ struct Bvh2BuildOptions {
   // ceil(n / granularity) tests, so an 8-wide leaf test (simd/triangle8.h)
   // makes full leaves of 8 as cheap as leaves of 1. 1 for scalar leaves.
   int leaf_granularity = 1;
-  // Subtrees at least this large are built as TBB tasks. 1024: the 1,368
-  // triangles of spider.obj built faster on two threads than on one only
-  // from here (a task costs microseconds, a 1024-triangle subtree ~0.2 ms).
+  // Subtrees at least this large are built as TBB tasks: a task costs
+  // microseconds, a 1024-triangle subtree ~0.2 ms
+  // (measured: docs/notes/kernels-builders.md).
   std::size_t parallel_threshold = 1024;
   // SBVH only: spatial splits add at most this fraction of the triangle
   // count in extra references (0.5: prim_ids holds at most 1.5 n entries).

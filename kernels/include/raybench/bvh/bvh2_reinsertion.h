@@ -3,6 +3,8 @@
 // insertion-based optimization of bounding volume hierarchies", CGF 2013), in
 // batches searched in parallel (Meister & Bittner, "Parallel reinsertion for
 // bounding volume hierarchy optimization", CGF 2018).
+// Guarantee: the same triangles in the leaves, a tree whose SAH cost never
+// rises, no deeper than max_depth.
 #pragma once
 
 #include <cstddef>
@@ -12,9 +14,8 @@
 namespace raybench {
 
 struct Bvh2ReinsertionOptions {
-  // 8 batches of 5 %: on sponza and conference, 20-26 % lower cost than the
-  // binned build (one triangle or packs of 8 per test), for 50-300 ms on one
-  // thread on top of its 100-240 ms; 3 batches reach 15-25 %.
+  // 8 batches of 5 %: about a quarter lower SAH cost than the binned build,
+  // for about as much build time again (measured: docs/notes/kernels-builders.md).
   int passes = 8;                // batches; fewer when a batch improves nothing
   float batch_fraction = 0.05f;  // the nodes of largest area tried per batch, as a fraction of all nodes
   int max_depth = 96;            // no reinsertion makes the tree deeper (Bvh2BuildOptions::max_sah_depth + 32)

@@ -2,9 +2,10 @@
 // kernel offers them (Linux, THP in "madvise" mode, Debian's default).
 //
 // Why: a fresh allocation faults on the first touch of every 4 KiB page,
-// and a BVH build touches all of its memory once, at once. For the
-// million-triangle scene that was about 2 us per page, 60 ms of a 400 ms
-// build; 2 MiB pages fault 512 times less often. Embree advises its build
+// and a BVH build touches all of its memory once, at once; 2 MiB pages
+// fault 512 times less often (measured: docs/notes/kernels-builders.md).
+// Where the kernel gives no huge pages the memory is ordinary pages, with
+// the same contents. Embree advises its build
 // memory the same way (MADV_HUGEPAGE in its os_malloc). Small arrays stay
 // with operator new.
 #pragma once

@@ -1,51 +1,35 @@
 // Single-ray traversal of a WideBvh<W> (W = 8: AVX2, W = 4: SSE, or their
-// scalar fallback): one W-wide slab test per node; the children entered are
-// pushed in the node's stored far-to-near order for the ray's octant
+// scalar fallback), closest hit and any hit.
+// Algorithm: one W-wide slab test per node; the children entered are pushed
+// in the node's stored far-to-near order for the ray's octant
 // (WideNode::far_to_near), without sorting distances: one permutation orders
 // them and a table-driven compaction pushes them with two stores,
 // branch-free. Their entry distances go on the stack too, so a subtree
 // farther than the current hit is skipped when popped. Leaves are tested W
-// triangles at once.
-// The traversal descends straight into the child it visits next (the
-// nearest, for the closest hit) instead of pushing it and popping it back: a
-// node's reference then comes from the node itself, not through a store and
-// a load of the stack, and a node with one child entered (the commonest
-// case) pushes nothing, as Embree's traversal does (bvh_traverser1.h). Measured against pushing every child and popping,
-// one thread, default build, same answers: primary rays 1.28-1.40x on
-// Sponza, Sibenik and Sponza-Dabrovic, diffuse 1.10-1.12x, shadow 1.12-1.16x.
+// triangles at once. The traversal descends straight into the child it
+// visits next instead of pushing it and popping it back, so a node with one
+// child entered (the commonest case) pushes nothing, as Embree's traversal
+// does (bvh_traverser1.h).
 // Any hit (shadow rays) returns at the first hit in the interval and orders
 // nothing per ray: the children entered are pushed in the node's lane order,
-// ref only (its interval never shrinks, so no entry distance is needed), as
-// Embree's any-hit traversal does. With WideLaneOrder::kByArea (the
-// backends' default build) the collapse puts the children in the lanes by
-// decreasing box area, so the smallest is visited first: small boxes are
-// mostly full of geometry, large ones mostly empty space (the probability
-// of occlusion per cost, Ize & Hansen, "RTSAH Traversal Order for Occlusion
-// Rays", EG 2011, which smallest-first approximates). Measured on the
-// default suite's shadow rays, one thread, default build, against the
-// BVH2's order: Sponza 1.21-1.28x, Sponza-Dabrovic 1.04x, Sibenik 1.03x,
-// Conference 1.01-1.02x, bunny 1.02x, Lucy 0.99x. The quality builds order
-// their lanes by each child's chance of ending the ray per cost
-// (WideLaneOrder::kOcclusion, Ize & Hansen's termination order), which
-// measured better on their trees than the BVH2's order, and the BVH2's
-// better than smallest first (wide_bvh_backend.cpp); on the default build
-// it was not. Cheapest subtree first (by expected SAH cost) was better on
-// Sponza-Dabrovic (1.04x) but worse on Sponza (0.84x) and Lucy (0.93x);
-// leaves first, worse everywhere. Nearest first (the octant order) was
-// 1.15x on Sponza but 0.89-0.93x on Lucy, bunny and Conference: it mostly
-// visits the surface around the ray's origin, which a shadow ray leaves
-// without hitting. Farthest first was slower on all six scenes measured
-// (0.80-0.99x), with every build.
+// ref only (its interval never shrinks), as Embree's any-hit traversal does.
+// The lane order is the collapse's (WideLaneOrder): kByArea, the default
+// build, visits the smallest box first, an approximation of Ize & Hansen's
+// occlusion order ("RTSAH Traversal Order for Occlusion Rays", EG 2011);
+// kOcclusion, the quality builds, is that termination order itself.
 // The leaf test and the box test are policies: WideMollerTrumbore,
 // WideMollerTrumboreEdges (needs WideLeaves::kMollerTrumboreEdges), or
 // Bvh8Watertight (8 wide, needs WideLeaves::kVertices); SlabFma (the
 // backends' plain test: one fused multiply-add per plane, as Embree's),
-// Slab, or a conservative test (with the watertight leaves no ray leaks
-// through the tree, as bvh2:watertight): SlabRobust pads every exit,
-// SlabRobustRay folds the padding into the ray (the backends' choice),
-// SlabFmaRobust into per-ray offsets of the fused form (it reads the tree's
-// bounds, the extent of every plane tested; measured slower here, see
-// prim/aabb_slab_fma_robust.h).
+// Slab, or a conservative test: SlabRobust pads every exit, SlabRobustRay
+// folds the padding into the ray (the backends' choice), SlabFmaRobust into
+// per-ray offsets of the fused form (prim/aabb_slab_fma_robust.h).
+// Guarantee: the answers are those of the leaf test over every triangle
+// whose box the box test enters; with the watertight leaves and a
+// conservative box test no ray leaks through the tree (as bvh2:watertight).
+// A popped subtree is skipped only when it is farther than the current hit.
+// measured (child orders, pushes, inlining; tried and dropped):
+// docs/notes/kernels-wide-traversal.md
 #pragma once
 
 #include <array>
@@ -77,7 +61,8 @@ struct Stack {
 // Pushes the children of `node` in `lanes` (bit i: lane i) in lane order,
 // refs only (any hit: its interval never shrinks). The AVX2 traversal pushes
 // so too, as Embree does (bvh_traverser1.h): for the two or three children a
-// shadow ray usually enters, measured 3-7 % faster than a compacted SIMD push.
+// shadow ray usually enters, it is faster than a compacted SIMD push
+// (measured: docs/notes/kernels-wide-traversal.md).
 template <int W>
 inline void push_in_lane_order(Stack<W>& stack, const WideNode<W>& node, unsigned lanes) {
   for (; lanes; lanes &= lanes - 1) stack.ref[stack.top++] = node.child[__builtin_ctz(lanes)];
@@ -167,12 +152,10 @@ struct WideMollerTrumboreEdges : WideMollerTrumbore {
 
 struct Bvh8Watertight {
   static constexpr WideLeaves kLeaves = WideLeaves::kVertices;
-  // The packs carried their triangles' indices in the fifth cache line,
-  // which the test loaded anyway (+2-4 %, the terrain +7-13 %, against
-  // pack_prims at each hit). With the normals the test reads six lines and
-  // the indices would take a seventh: through pack slots instead, measured
-  // the same (interleaved, one thread, six scenes, three ray kinds) with a
-  // seventh less leaf memory.
+  // Triangle indices through pack slots, not in the packs: with the normals
+  // the test reads six cache lines and the indices would take a seventh;
+  // the same speed with a seventh less leaf memory
+  // (measured: docs/notes/kernels-wide-traversal.md).
   static constexpr bool kPrimsInPack = false;
   using RayData = WatertightTriangle::RayData;
   RAYBENCH_INLINE static RayData precompute(const Ray& ray) { return WatertightTriangle::precompute(ray); }
@@ -187,15 +170,12 @@ struct Bvh8Watertight {
 // Inlined into the caller's loop over rays: called, the ray a backend has
 // just adjusted (with_nonnegative_tnear) goes through memory, where the
 // traversal's first loads of it likely span two stores and wait for them
-// (failed store forwarding). Measured: bvh8:reinsert 9 % faster on
-// Conference's shadow rays inlined.
+// (failed store forwarding). measured: docs/notes/kernels-wide-traversal.md
 // Closest hit: the Hit. Any hit: whether the ray hits anything in its interval.
 // With PackSlots the closest hit's prim is its pack slot (WideBvh::slot),
 // for the caller to map through pack_prims once its rays are all traced:
 // there, independent loads overlap; inside the traversal each could miss and
-// hold it up (measured for bvh8 against reading pack_prims at each hit,
-// interleaved, one thread, six scenes: diffuse rays +3.5 %, every scene
-// faster, primary +2.5 %, the terrain +6 % and +11 %).
+// hold it up (measured: docs/notes/kernels-wide-traversal.md).
 template <bool AnyHit, typename Leaf = WideMollerTrumbore, typename BoxTest = SlabFma, bool PackSlots = false, int W>
 RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
   Hit hit;
@@ -245,10 +225,8 @@ RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide(const WideBv
 #endif
         // Any hit: a lane hit, which is the whole answer. Looking up its
         // triangle in pack_prims, as a Hit would, loads a line of an array
-        // the traversal never reads otherwise, and the answer waited for it:
-        // measured, interleaved, one thread, shadow rays of six scenes,
-        // 4-5 % faster without (bvh8, bvh8:sbvh:reinsert,
-        // bvh8:watertight; every one of the 18 rows faster).
+        // the traversal never reads otherwise, and the answer waited for it
+        // (measured: docs/notes/kernels-wide-traversal.md).
         if constexpr (AnyHit) return true;
         else if constexpr (PackSlots) hit = {th.t, static_cast<std::int32_t>(WideBvh<W>::slot(pack, lane)), th.u, th.v};
         else hit = {th.t, Leaf::prim(bvh, pack, lane), th.u, th.v};

@@ -1,7 +1,8 @@
 // Branchless ray-AABB slab test with a precomputed reciprocal direction,
 // exact for zero direction components of either sign, NaN-safe.
 //
-// Source: seed 000 (../shared/seeds/000_*.txt) describes the slabs method
+// Source: the ray-AABB seed note (../shared/seeds/000_*.txt, i_dovelemon's
+// Chinese blog post, after Ericson) describes the slabs method
 // (Kay & Kajiya, "Ray Tracing Complex Scenes", SIGGRAPH 1986): per axis the
 // ray is inside the slab lower <= o + t d <= upper for t between
 // (lower - o) / d and (upper - o) / d, and it meets the box where the three

@@ -5,13 +5,10 @@
 // is in two offsets per axis, computed once per ray, so a box costs what
 // SlabFma's costs. The wide BVH traversal takes it as its box-test policy
 // (wide_bvh_traverse.h), but the backends' :robust option keeps
-// SlabRobustRay: in the benchmark, watertight leaves, SBVH with reinsertion,
-// this test was 15 % slower on the bunny's primary rays and 11 % on
-// Sponza-Dabrovic's shadow rays, where SlabRobustRay cost nothing against
-// the unpadded SlabFma; the per-ray offsets and three more constants held
-// through the traversal cost more than the subtraction per plane they save.
-// (An isolated one-process experiment had measured the opposite, 10-13 %
-// faster on shadow rays: code generation in the whole traversal decides.)
+// SlabRobustRay, which measured faster in the whole traversal: the per-ray
+// offsets and three more constants held through the traversal cost more
+// than the subtraction per plane they save
+// (measured: docs/notes/kernels-box-tests.md).
 //
 // Why SlabFma is not conservative: its distance plane * r - p, r = fl(1/d),
 // carries the rounding of p = fl(o * r), an error absolute in t (u |o / d|,

@@ -5,8 +5,8 @@
 // Source: Ize, "Robust BVH Ray Traversal", JCGT 2(2) 2013, which scales the
 // far planes' reciprocal direction once per ray instead of padding every
 // exit. SlabRobust pads each box's exit (exit + |exit| * 8u): three more
-// operations on the box test's critical path, measured at about 10 % of
-// bvh8:watertight. Here the far planes' distances use
+// operations on the box test's critical path
+// (measured: docs/notes/kernels-box-tests.md). Here the far planes' distances use
 // fl(fl(1/d) * (1 + 8u)), computed once per ray, and tmax is padded as
 // SlabRobust pads an exit (once per node in a traversal, off the box
 // test's path).

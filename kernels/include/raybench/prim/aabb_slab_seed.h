@@ -1,4 +1,5 @@
-// Seed 000's ray-AABB slab test, kept as the note writes it: the baseline
+// The ray-AABB seed note's slab test (seed 000, a Chinese blog post), kept
+// as the note writes it: the baseline
 // that shows what aabb_slab.h and aabb_slab_robust.h fix.
 //
 // Source: ../shared/seeds/000_*.txt (i_dovelemon, "3D空间中射线与轴向包围盒AABB的
@@ -52,7 +53,7 @@ struct SlabSeed {
       "seed 000 branchy slab test as written (|d| < 1e-6 is parallel, tmin from 0, NaN passes), float";
   static constexpr AccuracyClass accuracy = AccuracyClass::kEpsilon;
 
-  // The note's parallel threshold, `abs(dir.x) < 0.000001f` (seed 000): an
+  // The note's parallel threshold, `abs(dir.x) < 0.000001f`: an
   // absolute number compared with a direction of any length.
   static constexpr float kParallel = 0.000001f;
 

@@ -1,7 +1,8 @@
 // Ray-OBB test: the ray moved into the box's frame with Eigen, then a slab
 // test against the axis-aligned box [-h, h] written for every edge case.
 //
-// Source: the slab method of seed 004 (../shared/seeds/004_*.txt; Kay &
+// Source: the slab method of the ray-OBB seed note (../shared/seeds/004_*.txt,
+// a Chinese blog post, "OBB与Ray求交", 2022; Kay &
 // Kajiya, "Ray Tracing Complex Scenes", SIGGRAPH 1986), with its faults fixed
 // (see obb_seed.h and ../shared/EXTREMES.md):
 // - The running interval starts at [-inf, +inf], not at DBL_MIN, and the ray's

@@ -1,4 +1,5 @@
-// Seed 004's ray-OBB slab test, kept as the note writes it: the baseline that
+// The ray-OBB seed note's slab test (seed 004, a Chinese blog post), kept as
+// the note writes it: the baseline that
 // shows what obb_eigen.h fixes.
 //
 // Source: ../shared/seeds/004_*.txt ("OBB与Ray求交", 2022): for each box axis
@@ -13,7 +14,7 @@
 //   It acts as "t > 0": after `minT > maxT` has passed, maxT >= minT > 0, so
 //   the `maxT < 0` check never fires; and a ray whose origin lies on a face,
 //   pointing outward, has exit = 0 < DBL_MIN and misses the closed box it
-//   touches (the AABB note, seed 000, hits it).
+//   touches (the ray-AABB seed note, seed 000, hits it).
 // - `|f| > 1e-20` is absolute: a ray with |d| <= 1e-20 is "parallel" to every
 //   slab and misses every box its origin is not in, though hit/miss must not
 //   depend on |d| (EXTREMES.md G16).
@@ -47,7 +48,7 @@ struct ObbSeed {
       "seed 004 ray-OBB slab test as written (minT = DBL_MIN, |f| > 1e-20 parallel test)";
   static constexpr AccuracyClass accuracy = AccuracyClass::kEpsilon;
 
-  // The note's parallel threshold on f = n.d (seed 004): absolute, so it
+  // The note's parallel threshold on f = n.d: absolute, so it
   // depends on |d|.
   static constexpr double kParallelEpsilon = 1e-20;
 

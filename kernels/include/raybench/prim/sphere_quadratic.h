@@ -1,6 +1,7 @@
 // The textbook ray-sphere test: the quadratic formula with b^2 - 4ac, float.
 //
-// Source: seed 003 (../shared/seeds/003_*.txt), second half, which derives
+// Source: the ray-sphere seed note (../shared/seeds/003_*.txt, a Chinese
+// blog post), second half, which derives
 //   |o + t d - c|^2 = r^2  =>  a t^2 + b t + c' = 0,
 //   a = d.d, b = 2 d.(o - c), c' = (o - c).(o - c) - r^2,  t = (-b -/+ sqrt(b^2 - 4ac')) / 2a
 // and quotes chai3d's cIntersectionSegmentSphere, which is the same algebra.

@@ -1,4 +1,5 @@
-// Seed 003's geometric ray-sphere test, kept as the note writes it: the
+// The ray-sphere seed note's geometric test (seed 003, a Chinese blog post),
+// kept as the note writes it: the
 // baseline that shows what the fixed variants fix.
 //
 // Source: ../shared/seeds/003_*.txt (goteet, "射线与球的相交性检测",
@@ -44,7 +45,7 @@ struct SphereSeed {
   static constexpr AccuracyClass accuracy = AccuracyClass::kEpsilon;
 
   // The note's FLOAT_EPSILON: FLT_EPSILON = 2^-23, the spacing of floats at 1,
-  // used as an absolute threshold on r^2 - distance^2 (seed 003).
+  // used as an absolute threshold on r^2 - distance^2 (as the note uses it).
   static constexpr float kFloatEpsilon = std::numeric_limits<float>::epsilon();
 
   // The note's semantics, where they differ from the other sphere tests: dir

@@ -1,6 +1,7 @@
 // Möller–Trumbore ray-triangle test, without scale-dependent epsilons.
 //
-// Source: seed 002 (../shared/seeds/002_*.txt) derives it by Cramer's rule on
+// Source: the Möller–Trumbore seed note (../shared/seeds/002_*.txt, a
+// Chinese blog post) derives it by Cramer's rule on
 //   b*e1 - t*d + c*e2 = o - v0,  e1 = v1 - v0, e2 = v2 - v0
 // (Möller & Trumbore, "Fast, Minimum Storage Ray/Triangle Intersection",
 // JGT 1997). The seed rejects |det| < 1e-4, an absolute threshold: with legs

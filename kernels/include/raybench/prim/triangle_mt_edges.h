@@ -6,19 +6,15 @@
 // Why: on a scene whose tree does not fit in the caches (the
 // million-triangle terrain: bvh8 51 MB instead of 64) a ray's time goes
 // mostly to waiting for leaf lines, and fewer lines per leaf pay for the
-// extra cross product. Measured, bvh8:mt_edges against bvh8 in the same
-// runs, one thread: the terrain's diffuse rays +2.4 % (four runs, -0.4 to
-// +5.7 %), shadow rays +3.5 % (+1.0 to +5.3 %), primary within noise;
-// Sibenik, Sponza-Dabrovic, the bunny and Lucy, whose trees (4-10 MB) fit
-// in the last-level cache, 1-5 % slower, where the stored normal pays.
+// extra cross product; on scenes whose trees fit in the last-level cache
+// the stored normal is faster.
 // The normal is e1 x e2 in float with one fused multiply-add per component
 // (the SIMD form's arithmetic exactly), not in double as mt_normal rounds
-// it; everything after it is mt_normal's test. What that costs in accuracy
-// (results/accuracy-kernels.csv): on a collinear triangle the double normal
-// is exactly zero and every ray misses, while the float one keeps a
-// rounding residue, so 1 % of G08's collinear rays hit it; elsewhere within
-// a fraction of a point of mt_normal (needles, grazing rays, the stability
-// sweep's edge- and vertex-aimed rays).
+// it; everything after it is mt_normal's test.
+// Guarantee: mt_normal's, except on collinear triangles: the double normal
+// is exactly zero there and every ray misses, while the float one keeps a
+// rounding residue, so a few rays hit it (results/accuracy-kernels.csv).
+// measured: docs/notes/kernels-triangle-tests.md
 #pragma once
 
 #include <cmath>

@@ -2,7 +2,7 @@
 // intersector uses (its MoellerTrumboreIntersector1), and the form our wide
 // BVH leaves test (simd/wide_triangle.h) 4 or 8 at once.
 //
-// The same Cramer's rule as seed 002 (triangle_mt.h) on
+// The same Cramer's rule as the Möller–Trumbore seed note (triangle_mt.h) on
 //   u e1 + v e2 - t d = o - v0,
 // with the triple products regrouped around the normal: storing
 // e1' = v0 - v1, e2 = v2 - v0 and n = e1' x e2 per triangle, and with

@@ -1,4 +1,5 @@
-// Möller–Trumbore exactly as seed 002 writes it (../shared/seeds/002_*.txt,
+// Möller–Trumbore exactly as its seed note writes it (a Chinese blog post
+// deriving it by Cramer's rule, ../shared/seeds/002_*.txt;
 // "IntersectTriangle", D3DX style, float), kept so that raybench can show
 // where it fails. What it gets wrong (../shared/EXTREMES.md, measured):
 //  - `det < 0.0001f` is an absolute threshold: det scales with the square of

@@ -20,24 +20,20 @@
 // The third is the hit's t. The paper interpolates it from the vertices'
 // sheared depths along the ray, T = U*Az + V*Bz + W*Cz over U+V+W, so its
 // error scales with the triangle's extent, not with t: a ray leaving a large
-// triangle hit it again just in front of its origin (Conference's floor,
-// 2,600 units across: t = +1.5e-5 where the exact distance is -4.4e-5; 0.8 %
-// of Conference's diffuse and shadow rays through bvh8:watertight,
-// 0.09 % of Sponza's). Here t is the plane's distance from a vertex,
-// n . (v0 - org) / n . dir with n from the stored vertices' edges, as
-// Embree's Pluecker test and Moller-Trumbore compute it; it is exact for an
-// axis-aligned floor, whose normal has two zero components. The hit decision
-// (U, V, W) is the paper's, so the test stays watertight; only the distance
-// of a hit changes. Before it, pbrt-v4's remedy was built and reverted: a
-// hit only where the paper's t exceeds its error bound (Triangle::Intersect,
-// "ensure that computed triangle t is conservatively greater than zero").
-// It removed the self-hits (0.74 %, 0.79 % and 0.089 % to 0-0.006 %), but
-// the bound, which grows with the square of the depth over the triangle's
-// size, dropped true hits: far-origin rays 0.3 -> 3.1 % wrong on
-// Conference, 1.1 -> 15.5 % on Lucy, 12.6 -> 45 % on Sibenik; grazing
-// 0.02-0.3 -> 0.7-2.6 %; reintersection 0-0.09 -> 0.4-1.4 %; tiny
-// triangles 2.3 -> 6.3 %; and it cost 7 % speed.
-// Not culled: both faces hit. Degenerate triangles (U+V+W == 0) miss.
+// triangle hit it again just in front of its origin. Here t is the plane's
+// distance from a vertex, n . (v0 - org) / n . dir with n from the stored
+// vertices' edges, as Embree's Pluecker test and Moller-Trumbore compute it;
+// it is exact for an axis-aligned floor, whose normal has two zero
+// components. The hit decision (U, V, W) is the paper's, so the test stays
+// watertight; only the distance of a hit changes. (pbrt-v4's remedy, a hit
+// only where t exceeds its error bound, was built and reverted: it dropped
+// true hits.)
+// Guarantee: no cracks along shared edges and vertices; not culled: both
+// faces hit. Degenerate triangles (U+V+W == 0) miss; a NaN determinant or
+// distance (a NaN vertex, an infinite origin) or a NaN tmax gives no hit; a
+// ray parallel to the plane in float misses even for tmax = inf.
+// measured (self-hits, the dropped remedies, the setup's branches):
+// docs/notes/kernels-triangle-tests.md
 #pragma once
 
 #include <cmath>
@@ -64,22 +60,15 @@ struct WatertightTriangle {
     int kx, ky, kz;
     float sx, sy;
     // org[kx], org[ky], org[kz], set once per ray: indexed in the 8-wide
-    // leaf, org[r.kx] compiled to two compares and branches per axis on the
-    // origin GCC held in registers, about 20 instructions per leaf.
+    // leaf, org[r.kx] compiled to compares and branches per axis.
     float ox, oy, oz;
     // dir[kx], dir[ky], dir[kz], for the hit's distance (plane_distance).
     float dx, dy, dz;
   };
   // The axis choice and the swap are branches on the direction, which an
-  // incoherent ray set mispredicts: a probe put this setup at 2-8 % of
-  // bvh8's time on the bunny's diffuse rays (two leaf tests per ray). A
-  // branch-free form (kz by arithmetic, kx and ky from a table, dir and
-  // org indexed in local arrays) measured, bvh8:watertight, six
-  // scenes, six interleaved rounds: diffuse rays +2.5 % (geometric mean,
-  // five scenes faster), primary rays -4.5 % (the bunny and Lucy -8 %),
-  // whose branches predict. With SSE instead (the lanes permuted by a
-  // table row, one division for sx, sy and sz), primary rays -5 % and
-  // diffuse rays unchanged (four rounds). The branches stay.
+  // incoherent ray set mispredicts; the branch-free and SSE forms tried
+  // lost on primary rays, whose branches predict. The branches stay
+  // (measured: docs/notes/kernels-triangle-tests.md).
   RAYBENCH_INLINE static RayData precompute(const Ray& ray) {
     RayData r;
     r.org = ray.org;
@@ -152,10 +141,8 @@ struct WatertightTriangle {
   // extent, not with t (see the header comment). n . dir is summed too, not
   // taken from the determinants (n . dir = -det * |dir[kz]| in exact
   // arithmetic): det carries the shear's rounding, relative to the
-  // triangle's distance over its size, and the quotient of the precise
-  // numerator and that denominator measured 500-1,500 ulp wrong at the 99th
-  // percentile on primary rays (2 ulp before) and far-origin rays picked the
-  // wrong triangle up to 13 times as often (the accuracy suite).
+  // triangle's distance over its size, and the quotient was hundreds of ulp
+  // wrong (measured: docs/notes/kernels-triangle-tests.md).
   RAYBENCH_INLINE static float plane_distance(const RayData& r, const Vec3f& n, const Vec3f& a) {
     const float along_normal = std::fma(n[r.kx], a[r.kx], std::fma(n[r.ky], a[r.ky], n[r.kz] * a[r.kz]));
     const float speed_along_normal = std::fma(n[r.kx], r.dx, std::fma(n[r.ky], r.dy, n[r.kz] * r.dz));

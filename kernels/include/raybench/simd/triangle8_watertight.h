@@ -8,6 +8,11 @@
 // and neighbours must see bit-identical shared vertices), structure-of-arrays,
 // and their normals, for the hit's distance (the plane's, not the paper's).
 // AVX2 when the compiler targets it, else a scalar loop, same answers.
+// Guarantee: each lane's answer is the scalar test's (watertight, both
+// faces, degenerate and NaN lanes miss); unused lanes hold NaN and never
+// hit; on equal t the last lane wins.
+// measured (addressing, where to divide, exact lanes):
+// docs/notes/kernels-triangle-tests.md
 #pragma once
 
 #include <cstdint>
@@ -72,12 +77,9 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
                                       TriangleHit& out) {
   // Axis kx of vertex k lies at px + kVertex * k: one base per axis and
   // constant offsets. Indexed as t.v[k][r.kx], the compiler kept nine
-  // offsets, spilled them, and reloaded each before its vertex load; with the
-  // bases, measured 4-10 % more shadow rays per second through
-  // bvh8:watertight (bunny, Sibenik, Lucy, Sponza-Dabrovic, engine;
-  // one thread), primary and diffuse rays within noise. The gain is fragile:
-  // the same bases taken from reinterpret_cast<const float*>(&t) compiled
-  // differently and measured no faster than indexing.
+  // offsets, spilled them, and reloaded each before its vertex load. The
+  // gain is fragile: the same bases taken from reinterpret_cast compiled
+  // differently (measured: docs/notes/kernels-triangle-tests.md).
   constexpr int kVertex = 3 * 8;  // floats from one vertex's axis to the next vertex's
   static_assert(sizeof(TriangleVertices8::v[0]) == kVertex * sizeof(float));
   const float* px = t.v[0][r.kx];
@@ -119,25 +121,14 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
   const __m256 along_normal = _mm256_fmadd_ps(nx, ax, _mm256_fmadd_ps(ny, ay, _mm256_mul_ps(nz, az)));
   const __m256 speed_along_normal =
       _mm256_fmadd_ps(nx, _mm256_set1_ps(r.dx), _mm256_fmadd_ps(ny, _mm256_set1_ps(r.dy), _mm256_mul_ps(nz, _mm256_set1_ps(r.dz))));
-  // Divided for every pack: returning first when no lane is inside or
-  // exact saved the division but measured slower (interleaved, one thread,
-  // bvh8:watertight, five scenes: primary rays +3 %, diffuse and
-  // shadow rays 1.5-5 % slower; the branch mispredicts). Nor did a
-  // return before the division on the paper's scaled distance (before the
-  // plane's distance replaced it), which excludes the ray's own surface
-  // behind its origin (an inside lane in about half the packs a diffuse ray
-  // tests): with the scaled t and det of one sign, or with the paper's
-  // scaled interval test, 0 to -2.5 % (geometric means, same binaries
-  // interleaved, five scenes, three ray kinds, three rounds).
-  // Computed and divided before the edge test instead, for the division's
-  // latency to overlap it: -1 % (interleaved, six scenes, four rounds).
+  // Divided for every pack: an early return before the division (no lane
+  // inside or exact, or on the paper's scaled distance) mispredicts and
+  // measured slower, and so did dividing before the edge test
+  // (measured: docs/notes/kernels-triangle-tests.md).
   const __m256 tt = _mm256_div_ps(along_normal, speed_along_normal);
   // A lane strictly inside has det != 0 (three nonzero values of one sign
-  // do not sum to 0) and is never one of the exact lanes: no more tests.
-  // Measured against testing det != 0 and on-edge lanes (u, v or w == 0)
-  // separately, 2 operations more, interleaved, one thread: shadow rays
-  // through bvh8:watertight 2-3 % faster (11 rows of 6 scenes, two
-  // batches), diffuse and primary within noise.
+  // do not sum to 0) and is never one of the exact lanes: no more tests
+  // (measured: docs/notes/kernels-triangle-tests.md).
   const __m256 ok = _mm256_and_ps(inside, _mm256_and_ps(_mm256_cmp_ps(tt, _mm256_set1_ps(r.tnear), _CMP_GT_OQ),
                                                         _mm256_cmp_ps(tt, _mm256_set1_ps(WatertightTriangle::finite_tmax(tmax)), _CMP_LE_OQ)));
   int mask = _mm256_movemask_ps(ok);

@@ -1,7 +1,7 @@
 // One ray against W axis-aligned boxes at once (W = 8 or 4): the Slab test
 // of prim/aabb_slab.h (planes chosen by the direction's sign, a NaN distance
 // leaves the bound unchanged, a NaN bound misses) over boxes stored
-// structure-of-arrays, as wide BVH nodes store their children (issue 4).
+// structure-of-arrays, as wide BVH nodes store their children.
 // With BoxTest = SlabRobust the exit is padded by its rounding error as in
 // prim/aabb_slab_robust.h (Ize 2013): no box the exact ray touches is missed;
 // with SlabRobustRay the same guarantee comes from reciprocals scaled once

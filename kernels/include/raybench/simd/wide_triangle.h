@@ -3,15 +3,17 @@
 // one cross product, fused multiply-adds, no division until a lane passes),
 // same arithmetic in the same order, so each lane answers exactly as the
 // scalar test, over triangles stored structure-of-arrays, as wide BVH leaves
-// store them (issue 4). AVX2 (8 lanes) or SSE with FMA (4 lanes) when the
+// store them. AVX2 (8 lanes) or SSE with FMA (4 lanes) when the
 // compiler targets AVX2, else a scalar loop with the same interface.
-// Unused lanes hold NaN and miss.
-// Measured against the plain Möller–Trumbore form (two cross products, one
-// division per pack), same trees and rays, one thread: 2-5 % more rays per
-// second through bvh8 on Sponza-Dabrovic and the bunny, for 33 % more leaf
-// memory (12 floats per triangle instead of 9). TriangleEdgePack stores the
-// 9 (prim/triangle_mt_edges.h) and recomputes the normal per test, for
-// scenes whose leaves do not fit in the caches.
+// Möller & Trumbore, "Fast, Minimum Storage Ray/Triangle Intersection",
+// JGT 2(1), 1997.
+// Guarantee: each lane answers as the scalar test (not watertight: a ray
+// through a shared edge can miss both triangles); unused lanes hold NaN and
+// miss. The stored normal costs 33 % more leaf memory (12 floats per
+// triangle instead of 9) for a few per cent of speed; TriangleEdgePack
+// stores the 9 (prim/triangle_mt_edges.h) and recomputes the normal per
+// test, for scenes whose leaves do not fit in the caches.
+// measured: docs/notes/kernels-triangle-tests.md
 #pragma once
 
 #include <array>
@@ -168,8 +170,8 @@ RAYBENCH_INLINE int intersect_pack_simd(const Ray& ray, float tmax, const Pack& 
 
 // The batched test the build can run: SIMD where available. Inlined into
 // the traversal loop: called, it would spill and reload the ray's SIMD
-// registers around every leaf (all of them are caller-saved), measured to
-// cost bvh8 13-20 % on shadow rays.
+// registers around every leaf (all of them are caller-saved)
+// (measured: docs/notes/kernels-triangle-tests.md).
 template <typename Pack>
 RAYBENCH_INLINE int intersect_pack(const Ray& ray, float tmax, const Pack& t, TriangleHit& out) {
 #if defined(__AVX2__)
