@@ -14,6 +14,7 @@
 #include "scene/scene.h"
 #include "test_util.h"
 #include "measure/trace.h"
+#include "raybench/variants.h"
 
 namespace raybench {
 namespace {
@@ -263,12 +264,51 @@ TEST(WatertightNames, EveryBackendNamedWatertightLeaksNoRayUnlessNamedPlainBoxes
   }
 }
 
+// The bvh2 names of the triangle tests, from raybench/variants.h.
+std::vector<std::string> bvh2_variant_names() {
+  std::vector<std::string> names;
+  for_each_variant<TriangleTests>([&](auto test) { names.push_back("bvh2:" + std::string(decltype(test)::name)); });
+  return names;
+}
+
 TEST(BackendNames, EveryTriangleTestIsABvh2Backend) {
   std::vector<std::string> names;
   for (const BackendInfo& b : list_backends()) names.push_back(b.name);
-  for (const char* n : {"bvh2:mt", "bvh2:mt_seed", "bvh2:watertight", "bvh2:baldwin_weber", "bvh2:mt_double",
-                        "bvh2:mt_edges", "bvh2:watertight:plain_boxes", "bvh2:watertight:robust"})
+  for (const std::string& n : bvh2_variant_names()) {
     EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
+    EXPECT_NO_THROW(make_backend(n)) << n;
+  }
+  for (const char* n : {"bvh2:watertight:plain_boxes", "bvh2:watertight:robust"})
+    EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
+}
+
+// A manifest's "bvh2:*" (meshes/accuracy.toml) is how the accuracy suite
+// judges every triangle test without naming them.
+TEST(BackendNames, Bvh2StarIsBvh2WithEveryTriangleTestInTheVariantsList) {
+  EXPECT_EQ(expand_backend_patterns({"bvh2:*"}), bvh2_variant_names());
+  std::vector<std::string> expected{"embree"};
+  for (const std::string& n : bvh2_variant_names()) expected.push_back(n);
+  expected.push_back("bvh8:watertight");
+  EXPECT_EQ(expand_backend_patterns({"embree", "bvh2:*", "bvh8:watertight"}), expected);
+  EXPECT_NE(testing::input_error_of([] { expand_backend_patterns({"optix:*"}); }).find("unknown backend family 'optix'"),
+            std::string::npos);
+  EXPECT_NE(testing::input_error_of([] { expand_backend_patterns({"bvh8:*"}); }).find("bvh8 has no kernel variants"),
+            std::string::npos);
+}
+
+// Every family registers itself from its own file (RAYBENCH_BACKEND_FAMILY);
+// if the linker dropped one (a static library keeps only the objects that
+// something refers to) it would be missing here. The order is the families'
+// order keys.
+TEST(BackendRegistry, EveryFamilyIsRegisteredInItsOrder) {
+  std::vector<std::string> families;
+  for (const BackendInfo& b : list_backends()) {
+    const std::string family = b.name.substr(0, b.name.find(':'));
+    if (families.empty() || families.back() != family) families.push_back(family);
+  }
+  EXPECT_EQ(families, (std::vector<std::string>{"embree", "bvh2", "bvh8", "bvh4", "reference"}));
+  EXPECT_EQ(backend_accuracy_class("reference"), "exact");
+  EXPECT_EQ(backend_accuracy_class("bvh2:mt_seed"), "epsilon");
 }
 
 TEST(BackendNames, UnknownFamiliesAndOptionsAreErrorsThatSaySo) {

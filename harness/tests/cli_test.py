@@ -133,6 +133,10 @@ class BadInput(CliTest):
     def test_unknown_backend_and_ray_set(self):
         rays = self.make_rays("primary", 100)
         self.assertBadInput(self.trace(rays, backend="optix"), "unknown backend 'optix'")
+        # --backend takes a manifest's patterns ("bvh2:*": bvh2 with every triangle test); a family
+        # without variants is refused naming the pattern, not as an unknown option '*'.
+        self.assertBadInput(run("run", "--backend", "bvh8:*", "--out", self.path("r.csv")), "backend pattern 'bvh8:*'")
+        self.assertFalse(os.path.exists(self.path("r.csv")))
         self.assertBadInput(run("rays", "--scene", SCENE, "--kind", "specular", "-o", self.path("x.npy")), "specular")
         self.assertFalse(os.path.exists(self.path("x.npy")))
 

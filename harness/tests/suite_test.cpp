@@ -9,6 +9,7 @@
 
 #include "build_info.h"
 #include "io/error.h"
+#include "raybench/variants.h"
 #include "suite/results_table.h"
 #include "suite/scene_selection.h"
 #include "suite/settings_rules.h"
@@ -113,6 +114,21 @@ TEST(Suite, TheAccuracySuiteSweepsFromAMillionthToAMillionUnits) {
   EXPECT_NE(std::find(s.settings.backends.begin(), s.settings.backends.end(), "embree:robust"), s.settings.backends.end());
 }
 
+// meshes/accuracy.toml names "bvh2:*", not the triangle tests one by one:
+// every test in raybench/variants.h is judged, one added tomorrow too.
+TEST(Suite, TheAccuracySuiteJudgesBvh2WithEveryTriangleTest) {
+  const Suite s = load_suite(std::string(RAYBENCH_SOURCE_DIR) + "/meshes/accuracy.toml");
+  const std::vector<std::string>& b = s.settings.backends;
+  std::size_t variants = 0;
+  for_each_variant<TriangleTests>([&](auto test) {
+    const std::string name = "bvh2:" + std::string(decltype(test)::name);
+    EXPECT_EQ(std::count(b.begin(), b.end(), name), 1) << name;
+    ++variants;
+  });
+  EXPECT_EQ(variants, std::tuple_size_v<TriangleTests>);
+  EXPECT_EQ(std::count(b.begin(), b.end(), "bvh2:*"), 0);  // expanded when read
+}
+
 TEST(Suite, MistakesNameTheFileAndTheKey) {
   TempDir dir;
   const struct {
@@ -130,6 +146,8 @@ TEST(Suite, MistakesNameTheFileAndTheKey) {
       {"[[scene]]\nname = \"a\"\npath = \"p\"\ninside = { radius = 1 }\n", "scene[0].inside"},
       {"[[scene]]\nname = \"a\"\npath = \"p\"\nraysets = [\"edge\"]\n", "scene[0].raysets"},
       {"[defaults]\n", "no [[scene]]"},
+      {"[defaults]\nbackends = [\"bvh8:*\"]\n[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\n",
+       "defaults.backends': backend pattern 'bvh8:*'"},
       {"[[scene]]\nname = \"a\"\npath = \"p\"\nscale = -1\n", "scene[0].scale"},
       {"[[scene]]\nname = \"a\"\npath = \"p\"\nsweep = { scales = [] }\n", "scene[0].sweep.scales"},
       {"[[scene]]\nname = \"a\"\npath = \"p\"\nsweep = { scales = [1.0], offsets = [[1, 2]] }\n", "sweep.offsets"},

@@ -56,7 +56,38 @@ struct BackendInfo {
   std::string name;         // as given on the command line
   std::string description;
   std::string accuracy = "fast";  // the accuracy class of its triangle test; "epsilon" for seed-faithful ones
+  // One of its family's kernel variants (bvh2: one per entry of TriangleTests
+  // in raybench/variants.h): the pattern "<family>:*" names all of them
+  // (expand_backend_patterns).
+  bool variant = false;
 };
+
+// A backend family: every name "family[:option...]" is made by `make`
+// (given the full name and the options after the family), and `names` lists
+// its canonical names for `raybench backends`.
+using BackendFactory = std::unique_ptr<Backend> (*)(const std::string& name, const std::vector<std::string>& options,
+                                                    const BackendConfig& config);
+using BackendNames = std::vector<BackendInfo> (*)();
+
+// Adds a family to the registry; RAYBENCH_BACKEND_FAMILY calls it while the
+// program starts, so the registry is complete once main() runs (do not ask
+// it from another file's static initialiser; gtest evaluates
+// INSTANTIATE_TEST_SUITE_P's ValuesIn from main). `order` places the family
+// in list_backends() (ascending; embree 100, bvh2 200, bvh8 300, bvh4 400,
+// reference 900). Throws std::logic_error for a family name registered twice.
+bool register_backend_family(std::string family, int order, BackendFactory make, BackendNames names);
+
+// Registers a backend family from its own .cpp in harness/src/backends/, at
+// namespace scope: RAYBENCH_BACKEND_FAMILY("bvh2", 200, make_bvh2, bvh2_names);
+// Nothing else names the family: make_backend, list_backends and
+// backend_accuracy_class find it by name. The harness is an OBJECT library
+// (harness/CMakeLists.txt) so that the linker keeps this file although
+// nothing refers to it.
+#define RAYBENCH_BACKEND_FAMILY(family, order, make, names)                                    \
+  [[maybe_unused]] static const bool RAYBENCH_BACKEND_CAT_(raybench_backend_family_, __LINE__) = \
+      ::raybench::register_backend_family(family, order, make, names)
+#define RAYBENCH_BACKEND_CAT_(a, b) RAYBENCH_BACKEND_PASTE_(a, b)
+#define RAYBENCH_BACKEND_PASTE_(a, b) a##b
 
 // Makes a backend from "family[:option[:option...]]", e.g. "embree:high:robust"
 // or "bvh2:mt". Throws InputError naming an unknown family or option.
@@ -64,6 +95,13 @@ std::unique_ptr<Backend> make_backend(const std::string& name, const BackendConf
 
 // Every name make_backend accepts in its canonical forms, for --help.
 std::vector<BackendInfo> list_backends();
+
+// The backend names with each pattern "<family>:*" replaced by every name
+// of that family marked as a kernel variant (BackendInfo::variant), in
+// list_backends() order: "bvh2:*" is bvh2 with every triangle test of
+// raybench/variants.h. Other names pass through unchanged. Throws InputError
+// for a pattern whose family is unknown or has no variants.
+std::vector<std::string> expand_backend_patterns(const std::vector<std::string>& names);
 
 // The accuracy class of a backend name (as listed; options the list does not
 // spell out, such as a trailing ":robust", are looked through): "fast",

@@ -1,10 +1,12 @@
-#include <functional>
+// The registry of backend families. Each family registers itself from its
+// own file (RAYBENCH_BACKEND_FAMILY, backend.h); this file knows none of them.
+#include <algorithm>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "backends/backend.h"
-#include "backends/backend_families.h"
 #include "io/error.h"
 #include "raybench/bvh/bvh2_builders.h"
 
@@ -13,23 +15,37 @@ namespace {
 
 struct Family {
   std::string name;
-  std::function<std::unique_ptr<Backend>(const std::string&, const std::vector<std::string>&, const BackendConfig&)> make;
-  std::function<std::vector<BackendInfo>()> names;
+  int order;
+  BackendFactory make;
+  BackendNames names;
 };
 
-// The one list of backend families.
-const std::vector<Family>& families() {
-  static const std::vector<Family> list = {
-      {"embree", make_embree_backend, embree_backend_names},
-      {"bvh2", make_bvh2_backend, bvh2_backend_names},
-      {"bvh8", make_bvh8_backend, bvh8_backend_names},
-      {"bvh4", make_bvh4_backend, bvh4_backend_names},
-      {"reference", make_reference_backend, reference_backend_names},
-  };
+// Built while the program starts, by the families' registrars, in whatever
+// order the linker placed their files; kept sorted by (order, name). A
+// function-local static, so it exists before the first registrar runs.
+std::vector<Family>& families() {
+  static std::vector<Family> list;
   return list;
 }
 
+std::string known_families() {
+  std::vector<std::string> known;
+  for (const Family& f : families()) known.push_back(f.name);
+  return fmt::format("known families: {}; see 'raybench backends'", fmt::join(known, ", "));
+}
+
 }  // namespace
+
+bool register_backend_family(std::string family, int order, BackendFactory make, BackendNames names) {
+  std::vector<Family>& list = families();
+  for (const Family& f : list)
+    if (f.name == family) throw std::logic_error(fmt::format("backend family '{}' registered twice", family));
+  const auto at = std::find_if(list.begin(), list.end(), [&](const Family& f) {
+    return f.order > order || (f.order == order && f.name > family);
+  });
+  list.insert(at, Family{std::move(family), order, make, names});
+  return true;
+}
 
 std::unique_ptr<Backend> make_backend(const std::string& name, const BackendConfig& config) {
   std::vector<std::string> parts;
@@ -43,10 +59,7 @@ std::unique_ptr<Backend> make_backend(const std::string& name, const BackendConf
   for (const Family& f : families()) {
     if (f.name == parts[0]) return f.make(name, {parts.begin() + 1, parts.end()}, config);
   }
-  std::vector<std::string> known;
-  for (const Family& f : families()) known.push_back(f.name);
-  throw InputError("", fmt::format("unknown backend '{}' (known families: {}; see 'raybench backends')", name,
-                                   fmt::join(known, ", ")));
+  throw InputError("", fmt::format("unknown backend '{}' ({})", name, known_families()));
 }
 
 std::vector<BackendInfo> list_backends() {
@@ -54,6 +67,30 @@ std::vector<BackendInfo> list_backends() {
   for (const Family& f : families()) {
     auto names = f.names();
     out.insert(out.end(), names.begin(), names.end());
+  }
+  return out;
+}
+
+std::vector<std::string> expand_backend_patterns(const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  std::vector<BackendInfo> all;
+  for (const std::string& name : names) {
+    if (name.size() < 2 || name.compare(name.size() - 2, 2, ":*") != 0) {
+      out.push_back(name);
+      continue;
+    }
+    const std::string family = name.substr(0, name.size() - 2);
+    const auto known = std::find_if(families().begin(), families().end(), [&](const Family& f) { return f.name == family; });
+    if (known == families().end())
+      throw InputError("", fmt::format("unknown backend family '{}' in '{}' ({})", family, name, known_families()));
+    if (all.empty()) all = list_backends();
+    const std::size_t before = out.size();
+    for (const BackendInfo& b : all)
+      if (b.variant && b.name.rfind(family + ":", 0) == 0) out.push_back(b.name);
+    if (out.size() == before)
+      throw InputError("", fmt::format("backend pattern '{}': {} has no kernel variants to expand; name its backends "
+                                       "(see 'raybench backends')",
+                                       name, family));
   }
   return out;
 }

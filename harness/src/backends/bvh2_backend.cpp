@@ -1,5 +1,6 @@
 // Our binary BVH with a ray-triangle test chosen by name from
-// raybench/variants.h: "bvh2" uses the first entry, "bvh2:<test>" any of them;
+// raybench/variants.h: "bvh2" uses the first entry, "bvh2:<test>" any of them
+// (listed as the family's variants, so a manifest's "bvh2:*" names them all);
 // a "robust" option ("bvh2:mt:robust") traverses with the conservative box
 // test (SlabRobust), which never culls a box the exact ray touches, so a
 // watertight triangle test stays watertight through the tree: "bvh2:watertight"
@@ -16,7 +17,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "backends/backend_families.h"
+#include "backends/backend.h"
 #include "backends/bvh_options.h"
 #include "io/error.h"
 #include "raybench/bvh/bvh2_builders.h"
@@ -68,8 +69,6 @@ class Bvh2Backend final : public Backend {
   std::vector<typename Test::Prepared> prepared_;
 };
 
-}  // namespace
-
 std::unique_ptr<Backend> make_bvh2_backend(const std::string& name, const std::vector<std::string>& options,
                                            const BackendConfig&) {
   std::vector<std::string_view> tests;
@@ -99,7 +98,7 @@ std::vector<BackendInfo> bvh2_backend_names() {
                    fmt::format("bvh2 with {}{} [{}]", Test::description,
                                watertight ? ", traversed with the conservative box test (slab_robust): no ray leaks" : "",
                                to_string(Test::accuracy)),
-                   std::string(to_string(Test::accuracy))});
+                   std::string(to_string(Test::accuracy)), /*variant=*/true});
   });
   out.push_back({"bvh2:watertight:plain_boxes",
                  "bvh2:watertight traversed with the plain slab test: faster, but it leaks rays aimed at shared vertices "
@@ -122,5 +121,9 @@ std::vector<BackendInfo> bvh2_backend_names() {
                  default_accuracy});
   return out;
 }
+
+}  // namespace
+
+RAYBENCH_BACKEND_FAMILY("bvh2", 200, make_bvh2_backend, bvh2_backend_names);
 
 }  // namespace raybench

@@ -9,7 +9,8 @@
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
 
-#include "backends/backend_families.h"
+#include "backends/backend.h"
+#include "backends/embree_backend.h"
 #include "io/error.h"
 
 namespace raybench {
@@ -144,8 +145,6 @@ class EmbreeBackend final : public Backend {
   std::size_t memory_ = 0;
 };
 
-}  // namespace
-
 std::unique_ptr<Backend> make_embree_backend(const std::string& name, const std::vector<std::string>& options,
                                              const BackendConfig&) {
   EmbreeOptions parsed;
@@ -165,6 +164,10 @@ std::vector<BackendInfo> embree_backend_names() {
           {"embree:low", "Embree, low build quality (fast build)"},
           {"embree:robust", "Embree with RTC_SCENE_FLAG_ROBUST (options combine: embree:high:robust)", "robust"}};
 }
+
+}  // namespace
+
+RAYBENCH_BACKEND_FAMILY("embree", 100, make_embree_backend, embree_backend_names);
 
 std::string embree_version() {
   return RTC_VERSION_STRING;

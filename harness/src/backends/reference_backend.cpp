@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "backends/backend_families.h"
+#include "backends/backend.h"
 #include "io/error.h"
 #include "referee/referee.h"
 
@@ -64,8 +64,6 @@ class ReferenceBackend final : public Backend {
   std::unique_ptr<Referee> referee_;
 };
 
-}  // namespace
-
 std::unique_ptr<Backend> make_reference_backend(const std::string& name, const std::vector<std::string>& options,
                                                 const BackendConfig&) {
   if (!options.empty())
@@ -77,5 +75,9 @@ std::vector<BackendInfo> reference_backend_names() {
   return {{"reference", "exact referee: our BVH2 with conservative traversal, every candidate judged in exact arithmetic (CGAL, GMP)",
            "exact"}};
 }
+
+}  // namespace
+
+RAYBENCH_BACKEND_FAMILY("reference", 900, make_reference_backend, reference_backend_names);
 
 }  // namespace raybench

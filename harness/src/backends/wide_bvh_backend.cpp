@@ -23,7 +23,7 @@
 
 #include <fmt/format.h>
 
-#include "backends/backend_families.h"
+#include "backends/backend.h"
 #include "backends/bvh_options.h"
 #include "io/error.h"
 #include "raybench/bvh/bvh2_builders.h"
@@ -165,8 +165,6 @@ std::vector<BackendInfo> wide_backend_names() {
   return out;
 }
 
-}  // namespace
-
 std::unique_ptr<Backend> make_bvh8_backend(const std::string& name, const std::vector<std::string>& options,
                                            const BackendConfig&) {
   return make_wide_backend<8>(name, options);
@@ -178,5 +176,10 @@ std::unique_ptr<Backend> make_bvh4_backend(const std::string& name, const std::v
   return make_wide_backend<4>(name, options);
 }
 std::vector<BackendInfo> bvh4_backend_names() { return wide_backend_names<4>(); }
+
+}  // namespace
+
+RAYBENCH_BACKEND_FAMILY("bvh8", 300, make_bvh8_backend, bvh8_backend_names);
+RAYBENCH_BACKEND_FAMILY("bvh4", 400, make_bvh4_backend, bvh4_backend_names);
 
 }  // namespace raybench

@@ -165,7 +165,7 @@ int run(int argc, char** argv) {
   run_cmd->add_option("--rayset,-r", run_raysets, fmt::format("Ray sets: {} (default: the suite's)", fmt::join(rayset_kind_names(), ", ")))
       ->delimiter(',');
   run_cmd->add_option("--rays,-n", run_rays, "Rays per ray set (default: the suite's, 262144)")->type_name("INT");
-  run_cmd->add_option("--backend,-b", run_backends, "Backends, e.g. embree,embree:high,bvh2 (see 'raybench backends')")
+  run_cmd->add_option("--backend,-b", run_backends, "Backends, e.g. embree,embree:high,bvh2 (see 'raybench backends'); 'bvh2:*' is bvh2 with every triangle test")
       ->delimiter(',');
   run_cmd->add_option("--threads,-t", run_threads, "Thread counts, e.g. 1,2 (default: 1)")->delimiter(',')->type_name("INT");
   run_cmd->add_option("--reps", run_reps, "Timed repetitions per case; the median is reported (default: 5)")->type_name("INT");
@@ -441,7 +441,7 @@ int run(int argc, char** argv) {
     s = run_options.suite.settings;
     if (!run_raysets.empty()) s.raysets = run_raysets;
     run_options.raysets_from_command_line = !run_raysets.empty();
-    if (!run_backends.empty()) s.backends = run_backends;
+    if (!run_backends.empty()) s.backends = expand_backend_patterns(run_backends);
     for (const auto& apply : overrides) apply(s);
     run_options.interleave = !no_interleave;
     run_options.command_line = command_line(argc, argv);

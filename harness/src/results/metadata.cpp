@@ -15,7 +15,7 @@
 #include <unistd.h>
 
 #include "io/atomic_file.h"
-#include "backends/backend_families.h"
+#include "backends/embree_backend.h"
 #include "build_info.h"
 
 namespace raybench {

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "backends/backend.h"
 #include "io/error.h"
 #include "io/input_file.h"
 #include "scene/procedural.h"
@@ -268,6 +269,11 @@ Suite load_suite(const std::string& path) {
       }
     }
     s.backends = r.strings(*t, "defaults.", "backends", s.backends);
+    try {
+      s.backends = expand_backend_patterns(s.backends);  // "bvh2:*": every triangle test (backend.h)
+    } catch (const InputError& e) {
+      r.fail("defaults.backends", e.what());
+    }
     if (const toml::node* th = t->get("threads")) {
       const toml::array* a = th->as_array();
       if (!a || a->empty()) r.fail("defaults.threads", "expected an array of thread counts, e.g. [1, 2]");

@@ -1,7 +1,13 @@
-// The one list of kernel variants. The harness registers a backend per entry
-// (bvh2:<name>), the typed tests run over it, and benchmark names come from
-// each type's `name`. Adding a kernel variant means writing its header in
-// prim/ and adding its type to its family's list here; nothing else changes.
+// The one list of kernel variants; benchmark and CSV names come from each
+// type's `name`. Adding a ray-triangle test means writing its header in
+// prim/ and adding its type to TriangleTests; nothing else is edited, and
+// from this list alone the harness makes the backend bvh2:<name>
+// (backends/bvh2_backend.cpp), the accuracy suite judges it
+// (meshes/accuracy.toml names "bvh2:*"), the typed specification runs over
+// it unless its accuracy class is epsilon (kernels/tests/
+// triangle_variants_test.cpp), and `raybench kernels` and the kernel-level
+// accuracy rows time and judge it. The box, sphere and OBB typed tests pick
+// their types by the property they specify.
 #pragma once
 
 #include <tuple>
