@@ -123,10 +123,11 @@ TEST(KernelAccuracy, EveryRaySetHasAHitUnlessItIsMeantToMiss) {
   }
   ASSERT_GT(truth.size(), 40u);
   for (const auto& [key, hits] : truth) {
-    if (must_miss.count(key.second))
+    if (must_miss.count(key.second)) {
       EXPECT_EQ(hits, 0.0) << key.first << " " << key.second << " is meant to miss";
-    else if (!hits_by_chance.count(key.second))
+    } else if (!hits_by_chance.count(key.second)) {
       EXPECT_GT(hits, 0.0) << key.first << " " << key.second << ": no ray hits, the set tests nothing";
+    }
   }
 }
 
