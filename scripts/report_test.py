@@ -24,7 +24,7 @@ REPORT = os.path.join(SCRIPTS, "report")
 sys.path.insert(0, SCRIPTS)
 import report  # noqa: E402  (the data functions behind the plots, tested directly)
 
-# raybench's results schema (README, "Results").
+# raybench's results schema (docs/formats.md).
 COLUMNS = ["scene", "triangles", "rayset", "query", "rays", "backend", "threads", "build_ms",
            "build_ms_min", "build_ms_max", "memory_bytes", "mrays_s", "mrays_s_min",
            "mrays_s_max", "reps", "mrays_s_samples", "ratio_to_embree", "hit_rate", "agree_hit",

@@ -1,4 +1,4 @@
-"""The dependency direction of the source tree, as README "Layout" states it: the kernels
+"""The dependency direction of the source tree, as docs/layout.md states it: the kernels
 include nothing of the harness, and each harness folder includes only the folders below it
 in LAYERS (io first, the command line last), so a newcomer can read the tree bottom up.
 """

@@ -1,5 +1,5 @@
 // Specification of the results CSV (harness/src/results/results_csv.h): the schema
-// the README documents and later tools (compare, gate) read.
+// docs/formats.md documents and later tools (compare, gate) read.
 #include "results/results_csv.h"
 
 #include <cmath>

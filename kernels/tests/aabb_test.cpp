@@ -318,7 +318,7 @@ TYPED_TEST(FixedBoxTests, NanAnywhereInTheRayMisses) {
 }
 
 TYPED_TEST(FixedBoxTests, InfiniteOriginOrDirectionMisses) {
-  // README: a ray with Inf in its origin or direction counts as a miss.
+  // docs/raysets.md: a ray with Inf in its origin or direction counts as a miss.
   const Ray good = ray({-1, 0.5f, 0.5f}, {1, 0.125f, 0.125f});
   for (int axis = 0; axis < 3; ++axis)
     for (float inf : {kInf, -kInf}) {

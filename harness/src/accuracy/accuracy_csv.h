@@ -1,7 +1,7 @@
 // The accuracy CSV (results/accuracy.csv and results/accuracy-kernels.csv):
 // one row per (scene, transform, ray set, backend), every ray judged against
 // the exact referee. The column list below is the schema, documented in
-// README.md ("Accuracy"). Rates are fractions of the row's rays.
+// docs/accuracy.md and docs/formats.md. Rates are fractions of the row's rays.
 #pragma once
 
 #include <cmath>

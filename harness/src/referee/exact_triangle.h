@@ -2,7 +2,7 @@
 // accuracy report: hit or miss, and t, as real-number arithmetic would answer
 // for the float inputs actually given (every float is a rational number).
 //
-// Semantics (README.md, "Accuracy"; ../shared/EXTREMES.md, "Decide the
+// Semantics (docs/accuracy.md; ../shared/EXTREMES.md, "Decide the
 // semantics"): triangles are closed and two-sided; the ray covers
 // (max(tnear, 0), tfar]; a degenerate (zero-area) triangle is never hit, and
 // neither is a triangle whose plane contains the ray (G08, G19); an

@@ -135,7 +135,7 @@ enum class OutputFormat { kTable, kMarkdown, kJson };
 std::string format_comparison(const Comparison& c, const ResultsFile& base, const ResultsFile& current,
                               OutputFormat format, bool colour);
 
-// Gate thresholds (results/gate.toml; see README "Gating CI").
+// Gate thresholds (results/gate.toml; see docs/gating.md).
 struct GateConfig {
   double max_ratio_drop = 0.10;       // relative drop of ratio_to_embree ...
   double alpha = 0.01;                // ... that the U test also calls real

@@ -1,5 +1,5 @@
 // The results CSV: one row per (scene, ray set, backend, threads). The
-// column list below is the schema, documented in README.md ("Results").
+// column list below is the schema, documented in docs/formats.md.
 #pragma once
 
 #include <limits>

@@ -1,6 +1,6 @@
 // A scene as every backend receives it: one flat array of triangles.
 //
-// Order (documented in README.md, "Scenes"): the file's node hierarchy is
+// Order (documented in docs/scenes.md): the file's node hierarchy is
 // walked depth first, parent before children, children in file order; at each
 // node its meshes in the node's order; in each mesh its faces in file order,
 // polygons fan-triangulated by assimp. Node transforms are applied. Degenerate

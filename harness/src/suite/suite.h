@@ -1,5 +1,5 @@
 // A suite manifest (TOML, e.g. meshes/default.toml): which scenes, ray sets,
-// backends and settings a run uses. See README.md, "Suite manifests".
+// backends and settings a run uses. See docs/manifest.md.
 #pragma once
 
 #include <array>

@@ -63,7 +63,7 @@ struct Slab {
     p.org = ray.org;
     p.inv_dir = {1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z};
     for (int axis = 0; axis < 3; ++axis) p.negative[axis] = std::signbit(p.inv_dir[axis]);
-    // An infinite origin or direction is no ray (README: such rays count as
+    // An infinite origin or direction is no ray (docs/raysets.md: such rays count as
     // misses); a NaN tnear propagates through every test below as a miss.
     const bool valid = is_finite(ray.org) && is_finite(ray.dir);
     p.tnear = valid ? ray.tnear : std::numeric_limits<float>::quiet_NaN();
