@@ -6,8 +6,9 @@ For every scene and the primary, diffuse and shadow ray sets (one thread), it co
 - our best backend (every backend not named embree* or reference) with Embree's best (the faster
   of `embree` and `embree:high`, when the run has both): target >= 1.0 per scene and ray set,
   and >= 1.10 as a geometric mean;
-- our best watertight configuration (a backend name containing "watertight") with Embree's
-  default mode (`embree`): target >= 1.0;
+- our best watertight configuration (a backend name with the option "watertight" and not
+  "plain_boxes", the leaky combination: see is_watertight) with Embree's default mode (`embree`):
+  target >= 1.0;
 - the build time of the default builder (`bvh8`, else `bvh2`) with Embree's medium build
   (`embree`): target <= 1.0;
 - hit/miss agreement with Embree (>= 99.99 %) and same triangle where both hit, ties counted as
@@ -37,6 +38,15 @@ REQUIRED = ["scene", "rayset", "backend", "threads", "rays", "mrays_s", "build_m
             "agree_prim", "prim_ties"]
 NUMERIC = ["threads", "rays", "mrays_s", "build_ms", "hit_rate", "agree_hit", "agree_prim", "prim_ties", "mrays_s_min",
            "mrays_s_max", "build_ms_min", "build_ms_max"]
+
+
+def is_watertight(backend):
+    """A leak-free configuration: the watertight triangle test, traversed with the conservative box
+    test. Since issue 28 that is every name with the option "watertight" except those that add
+    "plain_boxes" (the plain box test leaks at shared vertices and edges). Runs before the rename
+    (results/README.md) called the leaky combination plain "bvh8:watertight"."""
+    options = backend.split(":")[1:]
+    return "watertight" in options and "plain_boxes" not in options
 
 
 def is_ours(backend):
@@ -81,7 +91,7 @@ def scorecard(rows, threads=1):
             continue
         embree_name, embree = max(embrees.items(), key=lambda kv: kv[1]["mrays_s"])
         best_name, best = max(ours.items(), key=lambda kv: kv[1]["mrays_s"])
-        watertight = {b: r for b, r in ours.items() if "watertight" in b}
+        watertight = {b: r for b, r in ours.items() if is_watertight(b)}
         wt_name, wt = max(watertight.items(), key=lambda kv: kv[1]["mrays_s"]) if watertight else (None, None)
         default = backends.get("embree")
         builder = ours.get("bvh8") or ours.get("bvh2")

@@ -12,14 +12,14 @@
 
 #include "accuracy/accuracy_csv.h"
 #include "accuracy/judge.h"
-#include "backend.h"
+#include "backends/backend.h"
 #include "build_info.h"
-#include "rayset.h"
+#include "rays/rayset.h"
 #include "referee/referee.h"
-#include "suite.h"
-#include "suite_run.h"
+#include "suite/suite.h"
+#include "suite/suite_run.h"
 #include "test_util.h"
-#include "trace.h"
+#include "measure/trace.h"
 
 namespace raybench {
 namespace {
@@ -114,7 +114,7 @@ TEST(AccuracyCsv, RoundTripsAndRejectsABadNumber) {
   r.offset_x = 148376;
   r.rayset = "vertex-aimed";
   r.query = "intersect";
-  r.backend = "bvh2:watertight:robust";
+  r.backend = "bvh2:watertight";
   r.accuracy_class = "watertight";
   r.rays = 100;
   r.false_miss = 0.25;
@@ -148,7 +148,7 @@ TEST(StabilitySweep, WatertightWithRobustTraversalLeaksNothingAtEveryScaleAndOff
     const Scene scene = load_suite_scene(entry);
     const RayGenerator generator(scene);
     const Referee referee(scene);
-    for (const char* name : {"bvh2:watertight:robust", "bvh8:watertight:robust"}) {
+    for (const char* name : {"bvh2:watertight", "bvh8:watertight"}) {
     const auto backend = make_backend(name);
     backend->build(scene);
     for (RaySetKind kind : {RaySetKind::kClosedInsideRandom, RaySetKind::kSharedEdgeAimed, RaySetKind::kVertexAimed}) {
@@ -184,7 +184,7 @@ TEST(AccuracyRun, SeedFailuresAndEmbreeLeaksAppearTheRefereeIsClean) {
   const std::string manifest = dir.write("acc.toml", R"(
 [defaults]
 rays = 4096
-backends = ["embree", "bvh2:mt_seed", "bvh2:watertight:robust", "reference"]
+backends = ["embree", "bvh2:mt_seed", "bvh2:watertight", "reference"]
 repetitions = 1
 build_repetitions = 1
 min_time = 0.001
@@ -219,7 +219,7 @@ raysets = ["shared-edge-aimed"]
   EXPECT_GT(seed.false_miss, 0.9 * seed.truth_hits) << "det < 1e-4 hides triangles with legs below 5e-3";
   EXPECT_EQ(seed.accuracy_class, "epsilon");
   EXPECT_GT(row("sphere", "shared-edge-aimed", "embree").false_miss, 0.0);
-  EXPECT_EQ(row("sphere", "shared-edge-aimed", "bvh2:watertight:robust").false_miss, 0.0);
+  EXPECT_EQ(row("sphere", "shared-edge-aimed", "bvh2:watertight").false_miss, 0.0);
   for (const AccuracyRow& r : rows) {
     EXPECT_GT(r.mrays_s, 0.0) << r.backend;
     if (r.rayset == "invalid-rays") {

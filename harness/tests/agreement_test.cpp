@@ -1,5 +1,5 @@
-// Specification of per-ray agreement (harness/src/agreement.h).
-#include "agreement.h"
+// Specification of per-ray agreement (harness/src/measure/agreement.h).
+#include "measure/agreement.h"
 
 #include <vector>
 

@@ -1,5 +1,5 @@
-// Specification of interleaved build timing (harness/src/build_timing.h).
-#include "build_timing.h"
+// Specification of interleaved build timing (harness/src/measure/build_timing.h).
+#include "measure/build_timing.h"
 
 #include <algorithm>
 #include <chrono>
@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
-#include "procedural.h"
+#include "scene/procedural.h"
 
 namespace raybench {
 namespace {

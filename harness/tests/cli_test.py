@@ -215,13 +215,13 @@ class SuiteRun(CliTestCase):
     def test_must_hit_ray_sets_count_leaks(self):
         out = self.path("leaks.csv")
         result = run("run", "--scene", "sphere", "--rays", "20000", "--reps", "1", "--build-reps", "1", "--min-time", "0.01",
-                     "--backend", "embree,bvh2:watertight:robust", "--out", out, "--rays-dir", self.path("rays"))
+                     "--backend", "embree,bvh2:watertight", "--out", out, "--rays-dir", self.path("rays"))
         self.assertEqual(result.returncode, 0, result.stderr)
         with open(out) as f:
             rows = {(r["rayset"], r["backend"]): r for r in csv.DictReader(f)}
         for rayset in ("closed-inside-random", "shared-edge-aimed", "vertex-aimed"):
             # Watertight triangles with conservative traversal: no ray leaks.
-            self.assertEqual(rows[(rayset, "bvh2:watertight:robust")]["leaks"], "0")
+            self.assertEqual(rows[(rayset, "bvh2:watertight")]["leaks"], "0")
         # Embree's default mode is not watertight (EXTREMES.md: ~22 % of vertex-aimed rays miss).
         self.assertGreater(int(rows[("vertex-aimed", "embree")]["leaks"]), 100)
 
@@ -282,7 +282,7 @@ class CompareAndGate(CliTestCase):
         suite = os.path.join(cls.shared.name, "suite.toml")
         with open(suite, "w") as f:
             f.write('[defaults]\nrays = 4000\nrepetitions = 7\nbuild_repetitions = 1\nmin_time = 0.01\nwarmup = 0.0\n'
-                    'raysets = ["primary", "diffuse"]\nbackends = ["embree", "bvh2", "bvh2:watertight:robust"]\n'
+                    'raysets = ["primary", "diffuse"]\nbackends = ["embree", "bvh2", "bvh2:watertight"]\n'
                     f'[[scene]]\nname = "terrain"\npath = "{SCENE}"\n'
                     '[[scene]]\nname = "sphere"\npath = "proc:sphere"\n'
                     'inside = { center = [0, 0, 0], radius = 0.9 }\nraysets = ["vertex-aimed"]\n')
@@ -376,12 +376,12 @@ class CompareAndGate(CliTestCase):
 
     def test_a_new_leak_of_a_watertight_backend_fails(self):
         def leaky(row):
-            if row["backend"] == "bvh2:watertight:robust" and row["rayset"] == "vertex-aimed":
+            if row["backend"] == "bvh2:watertight" and row["rayset"] == "vertex-aimed":
                 self.assertEqual(row["leaks"], "0")
                 row["leaks"] = "3"
         result = self.gate(self.doctored("leaky", leaky))
         self.assertEqual(result.returncode, 1, result.stdout + result.stderr)
-        self.assertIn("sphere/vertex-aimed/bvh2:watertight:robust/threads:1: new leaks: 3", result.stdout)
+        self.assertIn("sphere/vertex-aimed/bvh2:watertight/threads:1: new leaks: 3", result.stdout)
 
     def test_a_missing_row_fails(self):
         fields, rows = read_csv(self.baseline)

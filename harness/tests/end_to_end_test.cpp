@@ -2,13 +2,13 @@
 // rays, at least 99.99 % per-ray hit/miss agreement (issue 2's bar).
 #include <string>
 
-#include "agreement.h"
-#include "backend.h"
-#include "npy.h"
-#include "rayset.h"
-#include "scene.h"
+#include "measure/agreement.h"
+#include "backends/backend.h"
+#include "io/npy.h"
+#include "rays/rayset.h"
+#include "scene/scene.h"
 #include "test_util.h"
-#include "trace.h"
+#include "measure/trace.h"
 
 namespace raybench {
 namespace {

@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "random.h"
+#include "scene/random.h"
 #include "raybench/prim/aabb_slab_robust.h"
 #include "raybench/prim/sphere_precise.h"
 

@@ -17,7 +17,7 @@
 
 #include "accuracy/prim_raysets.h"
 #include "raybench/variants.h"
-#include "npy.h"
+#include "io/npy.h"
 #include "test_util.h"
 
 namespace raybench {

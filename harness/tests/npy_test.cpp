@@ -1,11 +1,14 @@
-// Specification of the .npy reader and writer (harness/src/npy.h).
-#include "npy.h"
+// Specification of the .npy reader and writer (harness/src/io/npy.h).
+#include "io/npy.h"
 
 #include <cstring>
 #include <fstream>
 #include <limits>
 
-#include "error.h"
+#include <fmt/format.h>
+#include <sys/stat.h>
+
+#include "io/error.h"
 #include "test_util.h"
 
 namespace raybench {
@@ -89,6 +92,81 @@ TEST(Npy, RejectsWhatIsNotARayFileNamingTheFileAndProblem) {
     EXPECT_NE(error.find(c.problem), std::string::npos) << c.name << ": " << error;
   }
   EXPECT_NE(error_of(dir.file("absent.npy")).find("no such file"), std::string::npos);
+}
+
+// Issue 28: a shape of (-16, 8) was read as (16, 8) (the regex skipped the
+// sign); anything but a tuple of non-negative integers is refused.
+TEST(Npy, AShapeIsATupleOfNonNegativeIntegersNothingElse) {
+  TempDir dir;
+  const struct {
+    const char* shape;
+    const char* problem;
+  } cases[] = {
+      {"(-16, 8)", "dimension 0 is negative"},
+      {"(16, -8)", "dimension 1 is negative"},
+      {"(+16, 8)", "dimension 0 is not an integer"},
+      {"(16.0, 8)", "unexpected '.' after dimension 0"},
+      {"(16, 8 8)", "unexpected '8' after dimension 1"},
+      {"(16,, 8)", "dimension 1 is not an integer"},
+      {"(0x10, 8)", "unexpected 'x' after dimension 0"},
+      {"(16)", "a 1-element tuple needs a trailing comma"},
+      {"(2*8, 8)", "unexpected '*' after dimension 0"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = dir.write(
+        "shape.npy", npy_bytes(fmt::format("{{'descr': '<f4', 'fortran_order': False, 'shape': {}, }}", c.shape), 512));
+    const std::string error = error_of(path);
+    EXPECT_NE(error.find(path + ": malformed .npy header: 'shape'"), std::string::npos) << c.shape << ": " << error;
+    EXPECT_NE(error.find(c.problem), std::string::npos) << c.shape << ": " << error;
+  }
+  // Spellings numpy writes, or a Python tuple may take, are read.
+  for (const char* shape : {"(16, 8)", "(16,8)", "(16, 8,)", "( 16 , 8 )"}) {
+    const std::string path = dir.write(
+        "ok.npy", npy_bytes(fmt::format("{{'descr': '<f4', 'fortran_order': False, 'shape': {}, }}", shape), 16 * 32));
+    EXPECT_EQ(read_ray_file(path).size(), 16u) << shape;
+  }
+}
+
+// Issue 28: overflowing dimensions said "stoull" or "cannot create
+// std::vector larger than max_size()". The size is checked against the file
+// before anything is allocated.
+TEST(Npy, HugeDimensionsAreRefusedBeforeAllocatingWithAMessageThatSaysWhy) {
+  TempDir dir;
+  const struct {
+    const char* shape;
+    const char* problem;
+  } cases[] = {
+      {"(99999999999999999999999, 8)", "dimension 0 (99999999999999999999999) is too large"},
+      {"(18446744073709551615, 8)", "more than the file's"},           // rows x 32 bytes overflows
+      {"(576460752303423488, 8)", "more than the file's"},             // 2^59 rows: exactly 2^64 bytes
+      {"(4611686018427387904, 8)", "more than the file's"},            // 2^62 rows
+      {"(1000000, 8)", "the header promises 1000000 rows of 32 bytes"},  // plausible, but the file is short
+  };
+  for (const auto& c : cases) {
+    const std::string path = dir.write(
+        "huge.npy", npy_bytes(fmt::format("{{'descr': '<f4', 'fortran_order': False, 'shape': {}, }}", c.shape), 64));
+    const std::string error = error_of(path);
+    EXPECT_NE(error.find(path), std::string::npos) << c.shape << ": " << error;
+    EXPECT_NE(error.find(c.problem), std::string::npos) << c.shape << ": " << error;
+  }
+  // The float64 reader takes its column count from the header: bounded too.
+  const std::string wide = dir.write(
+      "wide.npy", npy_bytes("{'descr': '<f8', 'fortran_order': False, 'shape': (1, 4611686018427387904), }", 64));
+  std::size_t rows = 0, columns = 0;
+  EXPECT_NE(testing::input_error_of([&] { read_npy_f64(wide, rows, columns); }).find("expected 1 to 1024 columns"),
+            std::string::npos);
+}
+
+// Issue 28: a FIFO given as a ray file blocked forever in open().
+TEST(Npy, ARayFileThatIsNotARegularFileIsRefusedWithoutOpeningIt) {
+  TempDir dir;
+  ASSERT_EQ(::mkfifo(dir.file("fifo.npy").c_str(), 0600), 0);
+  EXPECT_NE(error_of(dir.file("fifo.npy")).find("is a FIFO"), std::string::npos);
+  std::filesystem::create_directories(dir.file("folder.npy"));
+  EXPECT_NE(error_of(dir.file("folder.npy")).find("is a directory"), std::string::npos);
+  std::size_t rows = 0, columns = 0;
+  EXPECT_NE(testing::input_error_of([&] { read_npy_f64(dir.file("fifo.npy"), rows, columns); }).find("is a FIFO"),
+            std::string::npos);
 }
 
 TEST(Npy, Float64MatricesRoundTrip) {

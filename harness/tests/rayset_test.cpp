@@ -1,5 +1,5 @@
-// Specification of ray-set generation (harness/src/rayset.h).
-#include "rayset.h"
+// Specification of ray-set generation (harness/src/rays/rayset.h).
+#include "rays/rayset.h"
 
 #include <cmath>
 #include <algorithm>
@@ -7,9 +7,9 @@
 #include <cstring>
 #include <set>
 
-#include "error.h"
+#include "io/error.h"
 #include "raybench/bvh/bvh2_traverse.h"
-#include "scene.h"
+#include "scene/scene.h"
 #include "test_util.h"
 
 namespace raybench {

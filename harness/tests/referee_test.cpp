@@ -8,11 +8,11 @@
 
 #include <gtest/gtest.h>
 
-#include "random.h"
-#include "rayset.h"
+#include "scene/random.h"
+#include "rays/rayset.h"
 #include "referee/exact_triangle.h"
 #include "referee/referee.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace raybench {
 namespace {

@@ -1,6 +1,6 @@
-// Specification of the results CSV (harness/src/results_csv.h): the schema
+// Specification of the results CSV (harness/src/results/results_csv.h): the schema
 // the README documents and later tools (compare, gate) read.
-#include "results_csv.h"
+#include "results/results_csv.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -8,8 +8,8 @@
 #include <fstream>
 #include <map>
 
-#include "error.h"
-#include "metadata.h"
+#include "io/error.h"
+#include "results/metadata.h"
 #include "test_util.h"
 
 namespace raybench {
@@ -102,6 +102,26 @@ TEST(ResultsCsv, AFileFromBeforeTheSahCostColumnStillReads) {
   // An older column is still required.
   const auto broken = dir.write("broken.csv", "scene,triangles\nbunny,1\n");
   EXPECT_NE(testing::input_error_of([&] { read_results_csv(broken); }).find("missing column"), std::string::npos);
+}
+
+TEST(ResultsCsv, AFileSavedByASpreadsheetReads) {
+  // Excel's "CSV UTF-8" starts with a byte order mark and ends lines with
+  // CRLF: the header's first column read as "\xEF\xBB\xBFscene" ("missing
+  // column 'scene'") and its last as "leaks\r" before both were handled.
+  TempDir dir;
+  const auto path = dir.write(
+      "excel.csv",
+      "\xEF\xBB\xBFscene,triangles,rayset,query,rays,backend,threads,build_ms,build_ms_min,build_ms_max,memory_bytes,mrays_s,"
+      "mrays_s_min,mrays_s_max,reps,mrays_s_samples,ratio_to_embree,hit_rate,agree_hit,agree_prim,prim_ties,"
+      "t_relerr_max,t_relerr_p999,disagreements,leaks\r\n"
+      "sponza,262205,primary,intersect,262144,embree,1,109.478,101.859,139.236,17518080,2.92204,2.52573,3.24777,5,"
+      "2.92204;2.52573;3.24777;2.93679;2.76549,1,0.983913,1,1,0,0,0,0,7\r\n");
+  std::vector<std::size_t> lines;
+  const auto rows = read_results_csv(path, &lines);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].at("scene"), "sponza");
+  EXPECT_EQ(rows[0].at("leaks"), "7");
+  EXPECT_EQ(lines, std::vector<std::size_t>{2});
 }
 
 TEST(ResultsCsv, AFileWithoutTheSchemaIsRejected) {

@@ -1,10 +1,15 @@
-// Specification of suite manifests (harness/src/suite.h).
-#include "suite.h"
+// Specification of suite manifests (harness/src/suite/suite.h).
+#include "suite/suite.h"
 
 #include <algorithm>
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <sys/stat.h>
 
 #include "build_info.h"
-#include "error.h"
+#include "io/error.h"
+#include "suite/settings_rules.h"
 #include "test_util.h"
 
 namespace raybench {
@@ -134,6 +139,183 @@ TEST(Suite, MistakesNameTheFileAndTheKey) {
     EXPECT_NE(error.find(path), std::string::npos) << error;
     EXPECT_NE(error.find(c.problem), std::string::npos) << "expected '" << c.problem << "' in: " << error;
   }
+}
+
+// Issue 28: a manifest's numbers were not validated as the command line's
+// were (threads = 3000000000 wrapped to a negative count, min_time = 0 or NaN
+// aborted inside Google Benchmark, warmup = inf warmed up forever), and the
+// run-time check blamed a flag that was not given ("--reps must be at least 1").
+TEST(Suite, NumericSettingsAreRefusedNamingTheFileAndKeyNeverAFlag) {
+  TempDir dir;
+  const struct {
+    const char* defaults;
+    const char* key;
+  } cases[] = {
+      {"threads = [3000000000]", "'defaults.threads'"},
+      {"threads = [1, 0]", "'defaults.threads'"},
+      {"threads = [-2]", "'defaults.threads'"},
+      {"min_time = 0", "'defaults.min_time'"},
+      {"min_time = -1.0", "'defaults.min_time'"},
+      {"min_time = nan", "'defaults.min_time'"},
+      {"min_time = inf", "'defaults.min_time'"},
+      {"warmup = -1.0", "'defaults.warmup'"},
+      {"warmup = nan", "'defaults.warmup'"},
+      {"warmup = inf", "'defaults.warmup'"},
+      {"repetitions = 0", "'defaults.repetitions'"},
+      {"repetitions = 3000000000", "'defaults.repetitions'"},
+      {"build_repetitions = 0", "'defaults.build_repetitions'"},
+      {"rays = 0", "'defaults.rays'"},
+      {"rays = -5", "'defaults.rays'"},
+      {"rays = 1e5", "'defaults.rays'"},
+      {"rays = \"many\"", "'defaults.rays'"},
+      {"seed = -1", "'defaults.seed'"},
+  };
+  int i = 0;
+  for (const auto& c : cases) {
+    const auto path = dir.write("bad" + std::to_string(i++) + ".toml",
+                                std::string("[defaults]\n") + c.defaults + "\n[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\n");
+    const std::string error = error_of(path);
+    EXPECT_NE(error.find(path + ": " + c.key + ": must be"), std::string::npos) << c.defaults << ": " << error;
+    EXPECT_EQ(error.find("--"), std::string::npos) << c.defaults << ": " << error;
+  }
+}
+
+TEST(Suite, NumericSettingsWithinTheRulesAreRead) {
+  TempDir dir;
+  const auto path = dir.write("s.toml",
+                              "[defaults]\nrays = 268435456\nthreads = [1, 1024]\nrepetitions = 1000\nbuild_repetitions = 1\n"
+                              "seed = 0\nmin_time = 3600\nwarmup = 0\n[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\n");
+  const SuiteSettings s = load_suite(path).settings;
+  EXPECT_EQ(s.rays, 268435456u);
+  EXPECT_EQ(s.threads, (std::vector<int>{1, 1024}));
+  EXPECT_EQ(s.repetitions, 1000);
+  EXPECT_EQ(s.build_repetitions, 1);
+  EXPECT_EQ(s.seed, 0u);
+  EXPECT_EQ(s.min_time, 3600.0);
+  EXPECT_EQ(s.warmup, 0.0);
+}
+
+// A camera at NaN, at its own look-at point, or with `up` along the view
+// direction made all-NaN rays and a "successful" run (issue 28).
+TEST(Suite, ACameraLightAndBallMustBeFiniteAndACameraMustLookSomewhere) {
+  TempDir dir;
+  const std::string scene = "[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\n";
+  const struct {
+    const char* text;
+    const char* key;
+    const char* problem;
+  } cases[] = {
+      {"camera = { position = [nan, 0, 0], look_at = [0, 0, 0] }", "scene[0].camera.position", "finite"},
+      {"camera = { position = [0, inf, 5], look_at = [0, 0, 0] }", "scene[0].camera.position", "finite"},
+      {"camera = { position = [0, 0, 5], look_at = [0, 0, -inf] }", "scene[0].camera.look_at", "finite"},
+      {"camera = { position = [0, 0, 5], look_at = [0, 0, 0], up = [0, nan, 0] }", "scene[0].camera.up", "finite"},
+      {"camera = { position = [0, 0, 1e39], look_at = [0, 0, 0] }", "scene[0].camera.position", "finite"},
+      {"camera = { position = [0, 0, 1e19], look_at = [0, 0, 0] }", "scene[0].camera.position", "within"},
+      {"camera = { position = [1, 2, 3], look_at = [1, 2, 3] }", "scene[0].camera.look_at", "looks nowhere"},
+      {"camera = { position = [0, 5, 0], look_at = [0, 0, 0] }", "scene[0].camera.up", "parallel"},
+      {"camera = { position = [0, 0, 5], look_at = [0, 0, 0], up = [0, 0, -2] }", "scene[0].camera.up", "parallel"},
+      {"camera = { position = [0, 0, 5], look_at = [0, 0, 0], up = [0, 0, 0] }", "scene[0].camera.up", "[0, 0, 0]"},
+      {"camera = { position = [0, 0, 5], look_at = [0, 0, 0], fov = nan }", "scene[0].camera.fov", "(0, 180)"},
+      // float(1e7 + 1e-3) == float(1e7): the offset merges the camera with its target.
+      {"camera = { position = [0, 0, 1e-3], look_at = [0, 0, 0] }\noffset = [0, 0, 1e7]", "scene[0].camera.look_at",
+       "offset"},
+      {"light = [nan, 0, 0]", "scene[0].light", "finite"},
+      {"light = [0, inf, 0]", "scene[0].light", "finite"},
+      {"inside = { center = [0, nan, 0], radius = 0.5 }", "scene[0].inside.center", "finite"},
+      {"inside = { center = [0, 0, 0], radius = inf }", "scene[0].inside.radius", "finite"},
+      {"inside = { center = [0, 0, 0], radius = nan }", "scene[0].inside.radius", "> 0"},
+      {"sweep = { scales = [inf] }", "scene[0].sweep.scales", "finite"},
+      {"sweep = { scales = [1.0], max_quantisation = nan }", "scene[0].sweep.max_quantisation", "finite"},
+  };
+  int i = 0;
+  for (const auto& c : cases) {
+    const auto path = dir.write("cam" + std::to_string(i++) + ".toml", scene + c.text + "\n");
+    const std::string error = error_of(path);
+    EXPECT_NE(error.find(path + ": '" + c.key + "'"), std::string::npos) << c.text << ": " << error;
+    EXPECT_NE(error.find(c.problem), std::string::npos) << c.text << ": " << error;
+  }
+}
+
+// A scene's name goes into ray file names under --rays-dir and into the
+// results CSV: "../evil" wrote outside --rays-dir, a newline made a CSV
+// raybench could not read back (issue 28).
+TEST(Suite, SceneNamesThatWouldEscapeTheRaysDirOrBreakTheCsvAreRefused) {
+  TempDir dir;
+  int i = 0;
+  for (const char* name : {"../evil", "a/b", "/abs", "a\\\\b", "a\\nb", "a\\rb", "tab\\there", "a\\u007fb", "a,b"}) {
+    const auto path =
+        dir.write("name" + std::to_string(i++) + ".toml", fmt::format("[[scene]]\nname = \"{}\"\npath = \"proc:sphere\"\n", name));
+    const std::string error = error_of(path);
+    EXPECT_NE(error.find(path + ": 'scene[0].name': a scene name must not contain"), std::string::npos) << name << ": " << error;
+    EXPECT_EQ(error.find('\n'), std::string::npos) << name << ": the message must stay one line";
+  }
+  const auto fine = dir.write("fine.toml", "[[scene]]\nname = \"Sponza v2 (crytek)@s1e-06\"\npath = \"proc:sphere\"\n");
+  EXPECT_EQ(load_suite(fine).scenes[0].name, "Sponza v2 (crytek)@s1e-06");
+}
+
+TEST(Suite, AManifestThatIsNotARegularFileIsRefusedWithoutOpeningIt) {
+  TempDir dir;
+  std::filesystem::create_directories(dir.file("folder.toml"));
+  EXPECT_NE(error_of(dir.file("folder.toml")).find("is a directory"), std::string::npos);
+  ASSERT_EQ(::mkfifo(dir.file("fifo.toml").c_str(), 0600), 0);
+  EXPECT_NE(error_of(dir.file("fifo.toml")).find("is a FIFO"), std::string::npos);  // would block forever on open
+  EXPECT_NE(error_of(dir.file("absent.toml")).find("no such file"), std::string::npos);
+}
+
+// The rules themselves (settings_rules.h), as the command line feeds them.
+GivenValue flag(const std::string& text) { return GivenValue::from_flag("--x", text); }
+template <typename Rule>
+std::string refusal(Rule rule, const std::string& text) {
+  return testing::input_error_of([&] { rule(flag(text)); });
+}
+
+TEST(SettingsRules, IntegersAreWholeDecimalNumbersWithinTheirRange) {
+  EXPECT_EQ(rays_setting(flag("1")), 1u);
+  EXPECT_EQ(rays_setting(flag("268435456")), 268435456u);
+  EXPECT_EQ(threads_setting(flag("1024")), 1024);
+  EXPECT_EQ(pairs_setting(flag("8")), 8u);
+  for (const char* bad : {"0", "-5", "268435457", "99999999999999999999999", "1e5", "1.0", "", " 1", "1 ", "0x10", "abc", "nan"})
+    EXPECT_EQ(refusal(rays_setting, bad), fmt::format("--x: must be an integer from 1 to 268435456, got {}",
+                                                      *bad ? bad : "nothing"));
+  EXPECT_EQ(refusal(threads_setting, "3000000000"), "--x: must be an integer from 1 to 1024, got 3000000000");
+  EXPECT_EQ(refusal(pairs_setting, "-1"), "--x: must be an integer from 8 to 16777216, got -1");
+  EXPECT_EQ(refusal(repetitions_setting, "0"), "--x: must be an integer from 1 to 1000, got 0");
+  EXPECT_EQ(refusal(build_repetitions_setting, "1001"), "--x: must be an integer from 1 to 1000, got 1001");
+  EXPECT_EQ(refusal(kernel_rays_setting, "16777217"), "--x: must be an integer from 1 to 16777216, got 16777217");
+}
+
+TEST(SettingsRules, SeedsTakeEveryUnsigned64BitValue) {
+  EXPECT_EQ(seed_setting(flag("0")), 0u);
+  EXPECT_EQ(seed_setting(flag("18446744073709551615")), 18446744073709551615u);
+  for (const char* bad : {"-1", "18446744073709551616", "1.5", "x"})
+    EXPECT_NE(refusal(seed_setting, bad).find("must be an integer from 0 to 18446744073709551615"), std::string::npos) << bad;
+}
+
+TEST(SettingsRules, SecondsAreFiniteAndNeverTheAbortsOfGoogleBenchmark) {
+  EXPECT_EQ(min_time_setting(flag("0.01")), 0.01);
+  EXPECT_EQ(min_time_setting(flag("3600")), 3600.0);
+  EXPECT_EQ(warmup_setting(flag("0")), 0.0);
+  for (const char* bad : {"0", "-1", "nan", "inf", "-inf", "3601", "1e309", "soon"})
+    EXPECT_EQ(refusal(min_time_setting, bad), std::string("--x: must be a finite number of seconds in (0, 3600], got ") + bad);
+  for (const char* bad : {"-1", "-0.001", "nan", "inf", "3601"})
+    EXPECT_EQ(refusal(warmup_setting, bad), std::string("--x: must be a finite number of seconds in [0, 3600], got ") + bad);
+  EXPECT_EQ(refusal(alpha_setting, "nan"), "--x: must be a significance level in (0, 1), got nan");
+  EXPECT_EQ(refusal(alpha_setting, "1"), "--x: must be a significance level in (0, 1), got 1");
+  EXPECT_EQ(refusal(min_effect_setting, "-1"), "--x: must be a relative change in [0, 10], got -1");
+}
+
+TEST(SettingsRules, AManifestValueIsNamedByItsFileAndKey) {
+  const GivenValue v = GivenValue::from_manifest("m.toml", "defaults.threads", "3000000000", 3000000000, 3e9);
+  EXPECT_EQ(testing::input_error_of([&] { threads_setting(v); }),
+            "m.toml: 'defaults.threads': must be an integer from 1 to 1024, got 3000000000");
+}
+
+TEST(SettingsRules, SceneNames) {
+  EXPECT_EQ(scene_name_problem("sponza_dabrovic"), "");
+  EXPECT_EQ(scene_name_problem("sphere@s1e+06@o1e+07_1e+07_1e+07"), "");
+  for (const char* bad : {"", "../x", "a/b", "a\\b", "a\nb", "a\x01", "a\x7f", "a,b"})
+    EXPECT_NE(scene_name_problem(bad), "") << bad;
+  EXPECT_EQ(printable("a\nb\x7f"), "a\\x0ab\\x7f");
 }
 
 }  // namespace

@@ -5,7 +5,7 @@
 #include <fstream>
 #include <string>
 
-#include "error.h"
+#include "io/error.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -230,11 +230,17 @@ class Collapser {
     const float* gl = &cost_[l * W];
     const float* gr = &cost_[r * W];
     // split[k - 1]: the cheapest sharing of k >= 2 slots between the children.
+    // Every sharing gives each child at least one slot: one slot to the left
+    // is taken first, so that when every cost is infinite or NaN (box areas
+    // overflow float for coordinates beyond about 3.7e18, or are NaN for
+    // extents inf * 0), the choice is still a valid one: with no valid
+    // choice the plan indexed left[-1] and packed too many triangles.
     float split[W];
     std::int8_t split_left[W] = {};
     for (int k = 2; k <= W; ++k) {
-      split[k - 1] = kInf;
-      for (int i = 1; i < k; ++i) {
+      split[k - 1] = gl[0] + gr[k - 2];
+      split_left[k - 1] = 1;
+      for (int i = 2; i < k; ++i) {
         const float c = gl[i - 1] + gr[k - i - 1];
         if (c < split[k - 1]) {
           split[k - 1] = c;
@@ -244,7 +250,10 @@ class Collapser {
     }
     const float as_node = area + split[W - 1];
     const float as_pack = triangles <= W ? area : kInf;
-    s.as_pack = as_pack <= as_node;
+    // A pack unless a wide node costs less: the same choice as
+    // as_pack <= as_node for finite costs, but never a pack of more than
+    // W triangles, even when both costs are infinite or NaN.
+    s.as_pack = triangles <= W && !(as_node < as_pack);
     s.as_node_left = split_left[W - 1];
     const float one_slot = std::min(as_pack, as_node);
     g[0] = one_slot;

@@ -174,7 +174,7 @@ TEST(Watertight, ARayLeavingALargeTriangleDoesNotHitItAgain) {
   // behind the origin. The paper's t, interpolated from the vertices'
   // depths along the ray (up to 860 units), came out +1.5e-5, and 0.8 % of
   // Conference's diffuse and shadow rays hit the floor they leave through
-  // bvh8:watertight:robust. The plane's distance from a vertex is exact
+  // bvh8:watertight. The plane's distance from a vertex is exact
   // here (the floor's normal has two zero components), as Moller-Trumbore's.
   const Triangle floor{{-0x1.d971aap+9f, -0x1.927914p+0f, 0x1.4e3e98p+9f},
                        {0x1.9d5p+10f, -0x1.927914p+0f, 0x1.4e3e98p+9f},

@@ -165,6 +165,35 @@ std::string describe(WideLaneOrder lanes) {
 }
 constexpr WideLaneOrder kLaneOrders[] = {WideLaneOrder::kByArea, WideLaneOrder::kBvh2, WideLaneOrder::kOcclusion};
 
+// Coordinates of +-1e19 and +-3e38 (issue 28) are finite, but their boxes'
+// areas overflow float to inf (and an extent of inf times one of 0 makes
+// NaN), so every SAH cost of the collapse is inf or NaN. The tree must
+// still be a valid one: every triangle in a leaf under bounds that contain
+// it, packs of at most W triangles. The collapse segfaulted here (a plan
+// with no valid slot choice read left[-1] and packed too many triangles).
+TEST_P(WideBvhBuild, CoordinatesWhoseBoxAreasOverflowFloatStillCollapseToAValidTree) {
+  const bool splits = splits_triangles(GetParam());
+  for (const float scale : {1e18f, 3e37f}) {  // random_soup spans about +-11: up to +-1.1e19 and +-3.3e38
+    SCOPED_TRACE("scale " + std::to_string(scale));
+    auto tris = random_soup(2000, 4);
+    for (Triangle& t : tris)
+      for (Vec3f* v : {&t.v0, &t.v1, &t.v2}) *v = *v * scale;
+    tris.push_back({{-3e38f, 0, 0}, {3e38f, 0, 0}, {0, 1, 0}});  // an extent of inf, a flat box
+    for (const WideLaneOrder lanes : kLaneOrders) {
+      SCOPED_TRACE(describe(lanes));
+      for_each_width([&](auto width) {
+        const auto bvh = build<width()>(tris, lanes);
+        std::vector<std::vector<BBox>> leaves_of(tris.size());
+        check(bvh, tris, 0, bvh.bounds, splits, leaves_of);
+        for (std::size_t i = 0; i < tris.size(); ++i) {
+          if (splits) EXPECT_GE(leaves_of[i].size(), 1u) << "triangle " << i;
+          else EXPECT_EQ(leaves_of[i].size(), 1u) << "triangle " << i;
+        }
+      });
+    }
+  }
+}
+
 TEST_P(WideBvhBuild, ClosestAndAnyHitMatchBruteForceInEveryLaneOrder) {
   const auto tris = random_soup(4000, 2);
   for_each_width([&](auto width) {

@@ -5,9 +5,9 @@
 
 #include <fmt/format.h>
 
-#include "atomic_file.h"
-#include "csv.h"
-#include "error.h"
+#include "io/atomic_file.h"
+#include "io/csv.h"
+#include "io/error.h"
 
 namespace raybench {
 namespace {

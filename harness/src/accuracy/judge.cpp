@@ -5,7 +5,7 @@
 #include <limits>
 #include <vector>
 
-#include "agreement.h"
+#include "measure/agreement.h"
 
 namespace raybench {
 namespace {

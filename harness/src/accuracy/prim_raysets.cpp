@@ -10,7 +10,7 @@
 
 #include <fmt/format.h>
 
-#include "random.h"
+#include "scene/random.h"
 
 namespace raybench {
 namespace {

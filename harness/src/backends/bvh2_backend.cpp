@@ -1,10 +1,12 @@
 // Our binary BVH with a ray-triangle test chosen by name from
 // raybench/variants.h: "bvh2" uses the first entry, "bvh2:<test>" any of them;
-// a "robust" option ("bvh2:watertight:robust") traverses with the
-// conservative box test (SlabRobust), which never culls a box the exact ray
-// touches, so a watertight triangle test stays watertight through the tree.
+// a "robust" option ("bvh2:mt:robust") traverses with the conservative box
+// test (SlabRobust), which never culls a box the exact ray touches, so a
+// watertight triangle test stays watertight through the tree: "bvh2:watertight"
+// has it without asking, "bvh2:watertight:plain_boxes" is the plain slab test's
+// leaky combination (backends/bvh_options.h).
 // A builder option from raybench/bvh/bvh2_builders.h ("bvh2:sweep",
-// "bvh2:watertight:robust:lbvh") picks the builder; binned SAH by default.
+// "bvh2:watertight:lbvh") picks the builder; binned SAH by default.
 // "reinsert" optimises the built tree by reinsertion (bvh2_reinsertion.h).
 // Options come in any order, each kind at most once.
 #include <algorithm>
@@ -16,7 +18,7 @@
 
 #include "backends/backend_families.h"
 #include "backends/bvh_options.h"
-#include "error.h"
+#include "io/error.h"
 #include "raybench/bvh/bvh2_builders.h"
 #include "raybench/bvh/bvh2_traverse.h"
 #include "raybench/prim/aabb_slab_robust.h"
@@ -72,7 +74,7 @@ std::unique_ptr<Backend> make_bvh2_backend(const std::string& name, const std::v
                                            const BackendConfig&) {
   std::vector<std::string_view> tests;
   for_each_variant<TriangleTests>([&](auto test) { tests.push_back(decltype(test)::name); });
-  const BvhOptions parsed = parse_bvh_options(name, "bvh2", options, tests, "bvh2:watertight:robust:sweep:reinsert");
+  const BvhOptions parsed = parse_bvh_options(name, "bvh2", options, tests, "bvh2:watertight:sweep:reinsert");
   Bvh2BuildOptions build_options;
   build_options.reinsertion_passes = parsed.reinsertion_passes();
   const std::string wanted = parsed.test.value_or(std::string(std::tuple_element_t<0, TriangleTests>::name));
@@ -81,22 +83,32 @@ std::unique_ptr<Backend> make_bvh2_backend(const std::string& name, const std::v
     using Test = decltype(test);
     if (Test::name != wanted) return;
     const Bvh2Builder b = parsed.builder_or_default();
-    if (parsed.robust) made = std::make_unique<Bvh2Backend<Test, SlabRobust>>(name, b, build_options);
+    if (parsed.robust()) made = std::make_unique<Bvh2Backend<Test, SlabRobust>>(name, b, build_options);
     else made = std::make_unique<Bvh2Backend<Test, Slab>>(name, b, build_options);
   });
   return made;
 }
 
 std::vector<BackendInfo> bvh2_backend_names() {
+  const std::string default_accuracy(to_string(std::tuple_element_t<0, TriangleTests>::accuracy));
   std::vector<BackendInfo> out{{"bvh2", "our binary BVH, binned SAH build, with the default triangle test"}};
   for_each_variant<TriangleTests>([&](auto test) {
     using Test = decltype(test);
-    out.push_back({"bvh2:" + std::string(Test::name), fmt::format("bvh2 with {} [{}]", Test::description, to_string(Test::accuracy)),
+    const bool watertight = Test::name == kWatertightTest;  // traversed with the conservative box test
+    out.push_back({"bvh2:" + std::string(Test::name),
+                   fmt::format("bvh2 with {}{} [{}]", Test::description,
+                               watertight ? ", traversed with the conservative box test (slab_robust): no ray leaks" : "",
+                               to_string(Test::accuracy)),
                    std::string(to_string(Test::accuracy))});
   });
-  out.push_back({"bvh2:watertight:robust", "bvh2:<test>:robust traverses with the conservative box test (slab_robust)",
+  out.push_back({"bvh2:watertight:plain_boxes",
+                 "bvh2:watertight traversed with the plain slab test: faster, but it leaks rays aimed at shared vertices "
+                 "and edges through the box test [fast]",
+                 "fast"});
+  out.push_back({"bvh2:watertight:robust",
+                 "the same as bvh2:watertight (its name until the watertight test took the conservative box test by "
+                 "default); any bvh2 name takes :robust (slab_robust) or :plain_boxes (slab) for its box test",
                  "watertight"});
-  const std::string default_accuracy(to_string(std::tuple_element_t<0, TriangleTests>::accuracy));
   for (Bvh2Builder b : kBvh2Builders) {
     if (b == Bvh2Builder::kBinnedSah) continue;  // the default: plain "bvh2"
     out.push_back({"bvh2:" + std::string(to_string(b)),

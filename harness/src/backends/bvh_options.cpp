@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "error.h"
+#include "io/error.h"
 #include "raybench/bvh/bvh2_reinsertion.h"
 
 namespace raybench {
@@ -14,20 +14,22 @@ int BvhOptions::reinsertion_passes() const { return reinsert ? Bvh2ReinsertionOp
 
 BvhOptions parse_bvh_options(const std::string& name, std::string_view family, const std::vector<std::string>& options,
                              std::span<const std::string_view> tests, std::string_view example) {
-  const std::string valid = fmt::format("triangle tests: {}; builders: {}; traversal: robust; tree: {}",
-                                        fmt::join(tests, ", "), bvh2_builder_names(), kReinsertOption);
+  const std::string valid = fmt::format("triangle tests: {}; builders: {}; box tests: {}, {}; tree: {}",
+                                        fmt::join(tests, ", "), bvh2_builder_names(), kRobustBoxes, kPlainBoxes,
+                                        kReinsertOption);
   BvhOptions out;
   for (const std::string& o : options) {
     const std::optional<Bvh2Builder> as_builder = parse_bvh2_builder(o);
     const bool is_test = std::find(tests.begin(), tests.end(), o) != tests.end();
-    if (o != "robust" && o != kReinsertOption && !as_builder && !is_test)
+    const bool is_boxes = o == kRobustBoxes || o == kPlainBoxes;
+    if (!is_boxes && o != kReinsertOption && !as_builder && !is_test)
       throw InputError("", fmt::format("backend '{}': unknown option '{}' ({})", name, o, valid));
-    if ((o == "robust" && out.robust) || (o == kReinsertOption && out.reinsert) || (as_builder && out.builder) ||
+    if ((is_boxes && out.robust_boxes) || (o == kReinsertOption && out.reinsert) || (as_builder && out.builder) ||
         (is_test && out.test))
-      throw InputError("", fmt::format("backend '{}': {} takes a triangle test, a builder, 'robust' and '{}', each "
-                                       "at most once, in any order, e.g. {} ({})",
-                                       name, family, kReinsertOption, example, valid));
-    if (o == "robust") out.robust = true;
+      throw InputError("", fmt::format("backend '{}': {} takes a triangle test, a builder, a box test ('{}' or '{}') "
+                                       "and '{}', each at most once, in any order, e.g. {} ({})",
+                                       name, family, kRobustBoxes, kPlainBoxes, kReinsertOption, example, valid));
+    if (is_boxes) out.robust_boxes = o == kRobustBoxes;
     else if (o == kReinsertOption) out.reinsert = true;
     else if (as_builder) out.builder = as_builder;
     else out.test = o;

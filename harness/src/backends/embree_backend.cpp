@@ -10,10 +10,17 @@
 #include <fmt/format.h>
 
 #include "backends/backend_families.h"
-#include "error.h"
+#include "io/error.h"
 
 namespace raybench {
 namespace {
+
+// A ray whose interval (max(tnear, 0), tfar] is empty -- tfar below it,
+// tfar = -inf included -- can hit nothing, for every backend. Embree must not
+// be asked: it leaves such a ray's tfar untouched, and rtcOccluded1 reports an
+// occluded ray by setting tfar to -inf, so a ray that came with tfar = -inf
+// would read as occluded.
+bool has_empty_interval(const Ray& r) { return r.tfar < std::max(r.tnear, 0.0f); }
 
 struct EmbreeOptions {
   RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;
@@ -85,7 +92,7 @@ class EmbreeBackend final : public Backend {
     rtcInitIntersectContext(&context);
     for (std::size_t i = 0; i < rays.size(); ++i) {
       hits[i] = Hit{};
-      if (!is_traceable(rays[i])) continue;  // Debian's Embree asserts on NaN/Inf
+      if (!is_traceable(rays[i]) || has_empty_interval(rays[i])) continue;  // Debian's Embree asserts on NaN/Inf
       RTCRayHit rh;
       fill(rh.ray, rays[i]);
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -102,10 +109,11 @@ class EmbreeBackend final : public Backend {
     rtcInitIntersectContext(&context);
     for (std::size_t i = 0; i < rays.size(); ++i) {
       occluded[i] = 0;
-      if (!is_traceable(rays[i])) continue;
+      if (!is_traceable(rays[i]) || has_empty_interval(rays[i])) continue;
       RTCRay ray;
       fill(ray, rays[i]);
       rtcOccluded1(scene_, &context, &ray);
+      // tfar >= 0 went in (the interval is not empty): -inf is Embree's "occluded".
       occluded[i] = ray.tfar == -std::numeric_limits<float>::infinity() ? 1 : 0;
     }
   }

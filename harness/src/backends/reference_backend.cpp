@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "backends/backend_families.h"
-#include "error.h"
+#include "io/error.h"
 #include "referee/referee.h"
 
 namespace raybench {

@@ -8,10 +8,13 @@
 //     leaves a quarter smaller, prim/triangle_mt_edges.h: for scenes whose
 //     leaves do not fit in the caches)
 //     or, 8 wide only, watertight (Woop et al. 2013, simd/triangle8_watertight.h);
-//   robust: the conservative wide box test (Ize's padding folded into the
-//     ray, prim/aabb_slab_robust_ray.h), so that
-//     bvh8:watertight:robust leaks no ray through the tree either; without
-//     it, SlabFma (prim/aabb_slab_fma.h: one fused multiply-add per plane);
+//   a box test: robust, the conservative wide box test (Ize's padding folded
+//     into the ray, prim/aabb_slab_robust_ray.h), which culls no box the
+//     exact ray touches, or plain_boxes, SlabFma (prim/aabb_slab_fma.h: one
+//     fused multiply-add per plane). Unnamed: robust with the watertight
+//     leaves, so that bvh8:watertight leaks no ray through the tree either
+//     (bvh8:watertight:plain_boxes is the fast, leaky combination:
+//     backends/bvh_options.h), plain_boxes with the others;
 //   a builder from raybench/bvh/bvh2_builders.h ("bvh8:sweep", "bvh4:lbvh");
 //   reinsert: the BVH2 optimised by reinsertion before the collapse
 //     (bvh2_reinsertion.h).
@@ -22,7 +25,7 @@
 
 #include "backends/backend_families.h"
 #include "backends/bvh_options.h"
-#include "error.h"
+#include "io/error.h"
 #include "raybench/bvh/bvh2_builders.h"
 #include "raybench/bvh/wide_bvh_traverse.h"
 
@@ -113,14 +116,14 @@ std::unique_ptr<Backend> make_wide_backend(const std::string& name, const std::v
   const std::string family = fmt::format("bvh{}", W);
   const BvhOptions parsed = parse_bvh_options(
       name, family, options, W == 8 ? std::span<const std::string_view>(kTests8) : std::span<const std::string_view>(kTests4),
-      family + (W == 8 ? ":watertight:robust:sweep:reinsert" : ":robust:sweep:reinsert"));
+      family + (W == 8 ? ":watertight:sweep:reinsert" : ":robust:sweep:reinsert"));
   const Bvh2Builder b = parsed.builder_or_default();
   const int passes = parsed.reinsertion_passes();
   if constexpr (W == 8) {
-    if (parsed.test.value_or("mt") == "watertight") return make_with_box_test<8, Bvh8Watertight>(name, b, passes, parsed.robust);
+    if (parsed.test == kWatertightTest) return make_with_box_test<8, Bvh8Watertight>(name, b, passes, parsed.robust());
   }
-  if (parsed.test.value_or("mt") == "mt_edges") return make_with_box_test<W, WideMollerTrumboreEdges>(name, b, passes, parsed.robust);
-  return make_with_box_test<W, WideMollerTrumbore>(name, b, passes, parsed.robust);
+  if (parsed.test.value_or("mt") == "mt_edges") return make_with_box_test<W, WideMollerTrumboreEdges>(name, b, passes, parsed.robust());
+  return make_with_box_test<W, WideMollerTrumbore>(name, b, passes, parsed.robust());
 }
 
 template <int W>
@@ -143,14 +146,22 @@ std::vector<BackendInfo> wide_backend_names() {
                              "less leaf memory, for scenes whose leaves do not fit in the caches",
                              family)});
   if constexpr (W == 8) {
-    out.push_back(
-        {"bvh8:watertight", "bvh8 with 8-wide watertight leaves (Woop, Benthin & Wald 2013) [watertight]", "watertight"});
-    out.push_back({"bvh8:watertight:robust",
-                   "bvh8:<test>:robust traverses with the conservative 8-wide box test (slab_robust_ray): no ray leaks through the tree",
+    out.push_back({"bvh8:watertight",
+                   "bvh8 with 8-wide watertight leaves (Woop, Benthin & Wald 2013), traversed with the conservative "
+                   "8-wide box test (slab_robust_ray): no ray leaks through the tree [watertight]",
                    "watertight"});
-  } else {
-    out.push_back({family + ":robust", fmt::format("{} with the conservative {}-wide box test (slab_robust_ray)", family, W)});
+    out.push_back({"bvh8:watertight:plain_boxes",
+                   "bvh8:watertight traversed with the plain box test (slab_fma): faster, but it leaks rays aimed at "
+                   "shared vertices and edges through the box test [fast]",
+                   "fast"});
+    out.push_back({"bvh8:watertight:robust",
+                   "the same as bvh8:watertight (its name until the watertight leaves took the conservative box test by "
+                   "default)",
+                   "watertight"});
   }
+  out.push_back({family + ":robust", fmt::format("{} with the conservative {}-wide box test (slab_robust_ray); any {} "
+                                                 "name takes :robust or :plain_boxes (slab_fma, the default) for its box test",
+                                                 family, W, family)});
   return out;
 }
 

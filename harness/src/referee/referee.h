@@ -12,7 +12,7 @@
 
 #include "raybench/bvh/bvh2.h"
 #include "raybench/math/ray.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace raybench {
 

@@ -41,7 +41,7 @@
 // Bvh8Watertight (8 wide, needs WideLeaves::kVertices); SlabFma (the
 // backends' plain test: one fused multiply-add per plane, as Embree's),
 // Slab, or a conservative test (with the watertight leaves no ray leaks
-// through the tree, as bvh2:watertight:robust): SlabRobust pads every exit,
+// through the tree, as bvh2:watertight): SlabRobust pads every exit,
 // SlabRobustRay folds the padding into the ray (the backends' choice),
 // SlabFmaRobust into per-ray offsets of the fused form (it reads the tree's
 // bounds, the extent of every plane tested; measured slower here, see
@@ -248,7 +248,7 @@ RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide(const WideBv
         // the traversal never reads otherwise, and the answer waited for it:
         // measured, interleaved, one thread, shadow rays of six scenes,
         // 4-5 % faster without (bvh8, bvh8:sbvh:reinsert,
-        // bvh8:watertight:robust; every one of the 18 rows faster).
+        // bvh8:watertight; every one of the 18 rows faster).
         if constexpr (AnyHit) return true;
         else if constexpr (PackSlots) hit = {th.t, static_cast<std::int32_t>(WideBvh<W>::slot(pack, lane)), th.u, th.v};
         else hit = {th.t, Leaf::prim(bvh, pack, lane), th.u, th.v};

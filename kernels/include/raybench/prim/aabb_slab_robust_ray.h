@@ -6,7 +6,7 @@
 // far planes' reciprocal direction once per ray instead of padding every
 // exit. SlabRobust pads each box's exit (exit + |exit| * 8u): three more
 // operations on the box test's critical path, measured at about 10 % of
-// bvh8:watertight:robust. Here the far planes' distances use
+// bvh8:watertight. Here the far planes' distances use
 // fl(fl(1/d) * (1 + 8u)), computed once per ray, and tmax is padded as
 // SlabRobust pads an exit (once per node in a traversal, off the box
 // test's path).

@@ -22,7 +22,7 @@
 // error scales with the triangle's extent, not with t: a ray leaving a large
 // triangle hit it again just in front of its origin (Conference's floor,
 // 2,600 units across: t = +1.5e-5 where the exact distance is -4.4e-5; 0.8 %
-// of Conference's diffuse and shadow rays through bvh8:watertight:robust,
+// of Conference's diffuse and shadow rays through bvh8:watertight,
 // 0.09 % of Sponza's). Here t is the plane's distance from a vertex,
 // n . (v0 - org) / n . dir with n from the stored vertices' edges, as
 // Embree's Pluecker test and Moller-Trumbore compute it; it is exact for an
@@ -74,7 +74,7 @@ struct WatertightTriangle {
   // incoherent ray set mispredicts: a probe put this setup at 2-8 % of
   // bvh8's time on the bunny's diffuse rays (two leaf tests per ray). A
   // branch-free form (kz by arithmetic, kx and ky from a table, dir and
-  // org indexed in local arrays) measured, bvh8:watertight:robust, six
+  // org indexed in local arrays) measured, bvh8:watertight, six
   // scenes, six interleaved rounds: diffuse rays +2.5 % (geometric mean,
   // five scenes faster), primary rays -4.5 % (the bunny and Lucy -8 %),
   // whose branches predict. With SSE instead (the lanes permuted by a

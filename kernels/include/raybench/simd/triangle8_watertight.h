@@ -74,7 +74,7 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
   // constant offsets. Indexed as t.v[k][r.kx], the compiler kept nine
   // offsets, spilled them, and reloaded each before its vertex load; with the
   // bases, measured 4-10 % more shadow rays per second through
-  // bvh8:watertight:robust (bunny, Sibenik, Lucy, Sponza-Dabrovic, engine;
+  // bvh8:watertight (bunny, Sibenik, Lucy, Sponza-Dabrovic, engine;
   // one thread), primary and diffuse rays within noise. The gain is fragile:
   // the same bases taken from reinterpret_cast<const float*>(&t) compiled
   // differently and measured no faster than indexing.
@@ -121,7 +121,7 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
       _mm256_fmadd_ps(nx, _mm256_set1_ps(r.dx), _mm256_fmadd_ps(ny, _mm256_set1_ps(r.dy), _mm256_mul_ps(nz, _mm256_set1_ps(r.dz))));
   // Divided for every pack: returning first when no lane is inside or
   // exact saved the division but measured slower (interleaved, one thread,
-  // bvh8:watertight:robust, five scenes: primary rays +3 %, diffuse and
+  // bvh8:watertight, five scenes: primary rays +3 %, diffuse and
   // shadow rays 1.5-5 % slower; the branch mispredicts). Nor did a
   // return before the division on the paper's scaled distance (before the
   // plane's distance replaced it), which excludes the ray's own surface
@@ -136,7 +136,7 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
   // do not sum to 0) and is never one of the exact lanes: no more tests.
   // Measured against testing det != 0 and on-edge lanes (u, v or w == 0)
   // separately, 2 operations more, interleaved, one thread: shadow rays
-  // through bvh8:watertight:robust 2-3 % faster (11 rows of 6 scenes, two
+  // through bvh8:watertight 2-3 % faster (11 rows of 6 scenes, two
   // batches), diffuse and primary within noise.
   const __m256 ok = _mm256_and_ps(inside, _mm256_and_ps(_mm256_cmp_ps(tt, _mm256_set1_ps(r.tnear), _CMP_GT_OQ),
                                                         _mm256_cmp_ps(tt, _mm256_set1_ps(WatertightTriangle::finite_tmax(tmax)), _CMP_LE_OQ)));

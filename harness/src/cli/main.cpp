@@ -1,0 +1,518 @@
+// raybench: how fast is a ray-tracing kernel, and how often is it wrong, next
+// to Embree, on real meshes and the same rays. See README.md.
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <sstream>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "accuracy/kernel_accuracy.h"
+#include "measure/agreement.h"
+#include "build_info.h"
+#include "backends/backend.h"
+#include "results/compare.h"
+#include "io/error.h"
+#include "io/atomic_file.h"
+#include "io/input_file.h"
+#include "io/interrupt.h"
+#include "suite/kernel_bench.h"
+#include "results/metadata.h"
+#include "io/npy.h"
+#include "scene/procedural.h"
+#include "rays/rayset.h"
+#include "scene/scene.h"
+#include "suite/settings_rules.h"
+#include "suite/suite.h"
+#include "suite/suite_run.h"
+#include "measure/trace.h"
+
+namespace raybench {
+namespace {
+
+const std::string kDefaultSuite = std::string(RAYBENCH_SOURCE_DIR) + "/meshes/default.toml";
+const std::string kDefaultOut = std::string(RAYBENCH_SOURCE_DIR) + "/results/latest.csv";
+const std::string kDefaultRaysDir = std::string(RAYBENCH_SOURCE_DIR) + "/results/rays";
+
+// A scene argument is a suite scene's name or a mesh path / proc: spec.
+struct SceneArg {
+  Scene scene;
+  const SuiteScene* entry = nullptr;
+};
+
+SceneArg resolve_scene(const std::string& arg, const Suite* suite) {
+  SceneArg out;
+  out.entry = suite ? suite->find(arg) : nullptr;
+  out.scene = out.entry ? load_suite_scene(*out.entry) : load_scene(arg);
+  return out;
+}
+
+// The default suite is read only when a command needs a scene name from it;
+// a broken or absent default manifest must not stop `trace FILE`.
+const Suite* suite_if_readable(const std::string& path, bool explicit_path, Suite& storage) {
+  try {
+    storage = load_suite(path);
+    return &storage;
+  } catch (const InputError&) {
+    if (explicit_path) throw;
+    return nullptr;
+  }
+}
+
+// A numeric flag, given as text so that its rule (settings_rules.h), not
+// CLI11's conversion, judges it and names the flag.
+template <typename Rule>
+auto flag_value(const char* flag, const std::string& text, Rule rule) {
+  return rule(GivenValue::from_flag(flag, text));
+}
+
+// A file a command reads or writes, as the user named it.
+struct FileArg {
+  std::string flag;  // "--out"
+  std::string path;
+  std::string what;  // for messages: "--out results.csv", "the metadata of --out results.csv"
+};
+
+FileArg output(const std::string& flag, const std::string& path) { return {flag, path, flag + " " + path}; }
+FileArg metadata_of(const std::string& flag, const std::string& path) {
+  const std::string meta = metadata_path_for(path);
+  return {flag, meta, fmt::format("the metadata of {} {} ({})", flag, path, meta)};
+}
+
+// True when a and b name the same file: the same path once `.`, `..` and
+// symbolic links are resolved, or (both existing) the same inode.
+bool same_file(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec1, ec2;
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec1), ec1), cb = fs::weakly_canonical(fs::absolute(b, ec2), ec2);
+  if (!ec1 && !ec2 && ca == cb) return true;
+  std::error_code ec;
+  return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec);
+}
+
+// Before anything is read or computed: every output is a regular file or
+// absent (check_output_file: /dev/null, a FIFO or a directory is refused, not
+// replaced), and no output is another output or an input of the same command
+// (--accuracy equal to --out, or their .meta.toml files colliding, would
+// silently overwrite one result with the other).
+void check_outputs(const std::vector<FileArg>& outputs, const std::vector<FileArg>& inputs = {}) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const FileArg& o = outputs[i];
+    if (o.path.empty()) continue;
+    try {
+      check_output_file(o.path);
+    } catch (const InputError& e) {
+      throw InputError(o.flag, e.what());
+    }
+    for (std::size_t j = 0; j < i; ++j)
+      if (!outputs[j].path.empty() && same_file(o.path, outputs[j].path))
+        throw InputError("", fmt::format("{} is the same file as {}: each result needs its own file", o.what,
+                                         outputs[j].what));
+    for (const FileArg& in : inputs)
+      if (!in.path.empty() && same_file(o.path, in.path))
+        throw InputError("", fmt::format("{} is the same file as the input {}: it would be overwritten", o.what,
+                                         in.what));
+  }
+}
+
+// An output a command cannot do without: '' would fail only when the
+// results are written, after the whole run.
+void check_named(const std::string& flag, const std::string& path) {
+  if (path.empty()) throw InputError(flag, "must name a file, got ''");
+}
+
+// A folder raybench writes into: absent (it is created) or a directory.
+void check_output_folder(const std::string& flag, const std::string& path) {
+  std::error_code ec;
+  if (!path.empty() && std::filesystem::exists(path, ec) && !std::filesystem::is_directory(path, ec))
+    throw InputError(flag, path + " exists and is not a directory");
+}
+
+std::string command_line(int argc, char** argv) {
+  std::string s;
+  for (int i = 0; i < argc; ++i) {
+    if (i) s += ' ';
+    s += argv[i];
+  }
+  return s;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{"raybench: throughput and per-ray agreement of ray-tracing kernels against Embree, on the same rays.\n"
+               "Exit status: 0 success, 2 bad usage or input."};
+  app.require_subcommand(1);
+  app.set_help_all_flag("--help-all", "Show help for every command");
+
+  // raybench run
+  RunOptions run_options;
+  std::string suite_path = kDefaultSuite;
+  std::vector<std::string> run_raysets, run_backends, run_threads;
+  std::string run_rays, run_reps, run_build_reps, run_seed, run_min_time, run_warmup;
+  bool no_interleave = false, list_only = false;
+  run_options.out_csv = kDefaultOut;
+  run_options.rays_dir = kDefaultRaysDir;
+  CLI::App* run_cmd = app.add_subcommand("run", "Run a benchmark suite: every scene x ray set x backend x thread count");
+  run_cmd->add_option("--suite", suite_path, "Suite manifest (TOML)")->capture_default_str();
+  run_cmd->add_option("--scene,-s", run_options.scenes,
+                      "Scenes to run: names from the suite, mesh paths, or proc:<name> (default: every available suite scene)")
+      ->delimiter(',');
+  run_cmd->add_option("--rayset,-r", run_raysets, fmt::format("Ray sets: {} (default: the suite's)", fmt::join(rayset_kind_names(), ", ")))
+      ->delimiter(',');
+  run_cmd->add_option("--rays,-n", run_rays, "Rays per ray set (default: the suite's, 262144)")->type_name("INT");
+  run_cmd->add_option("--backend,-b", run_backends, "Backends, e.g. embree,embree:high,bvh2 (see 'raybench backends')")
+      ->delimiter(',');
+  run_cmd->add_option("--threads,-t", run_threads, "Thread counts, e.g. 1,2 (default: 1)")->delimiter(',')->type_name("INT");
+  run_cmd->add_option("--reps", run_reps, "Timed repetitions per case; the median is reported (default: 5)")->type_name("INT");
+  run_cmd->add_option("--build-reps", run_build_reps, "Timed rounds of builds per backend, interleaved across backends after one untimed build each; a build shorter than --min-time is repeated within its round (default: 3)")->type_name("INT");
+  run_cmd->add_option("--seed", run_seed, "Ray generation seed (default: 1)")->type_name("INT");
+  run_cmd->add_option("--min-time", run_min_time, "Minimum seconds per repetition, of a trace or of a round of builds (default: 0.05)")->type_name("SECONDS");
+  run_cmd->add_option("--warmup", run_warmup, "Untimed warm-up seconds per case (default: 0.05)")->type_name("SECONDS");
+  run_cmd->add_option("--out,-o", run_options.out_csv, "Results CSV; metadata goes beside it as .meta.toml")->capture_default_str();
+  run_cmd->add_option("--rays-dir", run_options.rays_dir, "Where ray sets are stored and reused")->capture_default_str();
+  run_cmd->add_flag("--no-interleave", no_interleave, "Run each case's repetitions back to back instead of interleaved");
+  run_cmd->add_flag("--list", list_only, "List the suite's scenes and whether they are available, then exit");
+  run_cmd->add_option("--accuracy", run_options.accuracy_csv,
+                      "Also judge every ray with the exact referee and write the accuracy CSV here "
+                      "(e.g. results/accuracy.csv; see scripts/accuracy)");
+
+  // raybench rays
+  std::string rays_scene, rays_kind = "primary", rays_out, rays_suite = kDefaultSuite;
+  std::string rays_count = "262144", rays_seed = "1";
+  CLI::App* rays_cmd = app.add_subcommand("rays", "Generate a ray set and store it as .npy, float32 (N, 8): ox oy oz tnear dx dy dz tfar");
+  rays_cmd->add_option("--scene,-s", rays_scene, "Mesh path, proc:<name>, or a suite scene name (uses its camera)")->required();
+  rays_cmd->add_option("--kind,-k", rays_kind, fmt::format("Ray set: {}", fmt::join(rayset_kind_names(), ", ")))->capture_default_str();
+  rays_cmd->add_option("--count,-n", rays_count, "Number of rays")->capture_default_str()->type_name("INT");
+  rays_cmd->add_option("--seed", rays_seed, "Seed")->capture_default_str()->type_name("INT");
+  rays_cmd->add_option("--suite", rays_suite, "Suite manifest to look scene names up in")->capture_default_str();
+  rays_cmd->add_option("--out,-o", rays_out, "Output .npy file")->required();
+
+  // raybench trace
+  std::string trace_scene, trace_rays, trace_backend = "bvh2", trace_out, trace_suite = kDefaultSuite;
+  bool trace_occluded = false;
+  std::string trace_threads = "1";
+  CLI::App* trace_cmd = app.add_subcommand(
+      "trace", "Trace a ray file with one backend and write hits as .npy, float64 (N, 4): t prim u v (t=inf, prim=-1 on a miss)");
+  trace_cmd->add_option("--scene,-s", trace_scene, "Mesh path, proc:<name>, or a suite scene name")->required();
+  trace_cmd->add_option("--rays", trace_rays, "Ray file (.npy, float32, shape (N, 8))")->required();
+  trace_cmd->add_option("--backend,-b", trace_backend, "Backend name (see 'raybench backends')")->capture_default_str();
+  trace_cmd->add_option("--out,-o", trace_out, "Output .npy file")->required();
+  trace_cmd->add_flag("--occluded", trace_occluded,
+                      "Any-hit occlusion query instead of closest hit; writes float64 (N, 1): 1 occluded, 0 not");
+  trace_cmd->add_option("--threads,-t", trace_threads, "Threads")->capture_default_str()->type_name("INT");
+  trace_cmd->add_option("--suite", trace_suite, "Suite manifest to look scene names up in")->capture_default_str();
+
+  // raybench kernels
+  KernelBenchOptions kernel_options;
+  kernel_options.out_csv = std::string(RAYBENCH_SOURCE_DIR) + "/results/kernels.csv";
+  kernel_options.out_json = std::string(RAYBENCH_SOURCE_DIR) + "/results/kernels.json";
+  CLI::App* kernels_cmd = app.add_subcommand(
+      "kernels", "Microbenchmark every kernel variant alone: ns per ray-primitive test, hit- and miss-heavy, scalar and 8-wide");
+  kernels_cmd->add_option("--out,-o", kernel_options.out_csv, "Results CSV (+ .meta.toml beside it)")->capture_default_str();
+  kernels_cmd->add_option("--json", kernel_options.out_json, "Google Benchmark JSON output ('' for none)")->capture_default_str();
+  kernels_cmd->add_option("--filter", kernel_options.filter, "Only cases whose name contains this, e.g. triangle/ or /miss");
+  std::string kernels_reps = std::to_string(kernel_options.repetitions), kernels_min_time = fmt::format("{}", kernel_options.min_time),
+              kernels_pairs = std::to_string(kernel_options.pairs);
+  kernels_cmd->add_option("--reps", kernels_reps, "Timed repetitions per case")->capture_default_str()->type_name("INT");
+  kernels_cmd->add_option("--min-time", kernels_min_time, "Minimum seconds per repetition")->capture_default_str()->type_name("SECONDS");
+  kernels_cmd->add_option("--pairs", kernels_pairs, "Ray-primitive pairs per family and input")->capture_default_str()->type_name("INT");
+
+  // raybench accuracy-kernels
+  KernelAccuracyOptions kernel_accuracy_options;
+  kernel_accuracy_options.out_csv = std::string(RAYBENCH_SOURCE_DIR) + "/results/accuracy-kernels.csv";
+  CLI::App* accuracy_kernels_cmd = app.add_subcommand(
+      "accuracy-kernels", "Judge every box, OBB, sphere and triangle kernel variant alone on the extreme ray sets "
+                          "against exact referees, and time it (accuracy CSV)");
+  accuracy_kernels_cmd->add_option("--out,-o", kernel_accuracy_options.out_csv, "Accuracy CSV (+ .meta.toml beside it)")
+      ->capture_default_str();
+  accuracy_kernels_cmd->add_option("--filter", kernel_accuracy_options.filter,
+                                   "Only rows whose <scene>/<rayset>/<backend> contains this, e.g. prim:sphere or kernel:slab_seed");
+  std::string kernel_accuracy_rays = std::to_string(kernel_accuracy_options.rays),
+              kernel_accuracy_seed = std::to_string(kernel_accuracy_options.seed);
+  accuracy_kernels_cmd->add_option("--rays,-n", kernel_accuracy_rays, "Rays per ray set")->capture_default_str()->type_name("INT");
+  accuracy_kernels_cmd->add_option("--seed", kernel_accuracy_seed, "Ray generation seed")->capture_default_str()->type_name("INT");
+  kernel_accuracy_options.rays_dir = kDefaultRaysDir;
+  accuracy_kernels_cmd->add_option("--rays-dir", kernel_accuracy_options.rays_dir,
+                                   "Where each ray set is stored as .npy (rays, and the primitive of each ray); '' for nowhere")
+      ->capture_default_str();
+
+  // raybench compare
+  std::string compare_base, compare_current, compare_format = "table", compare_out;
+  bool compare_force = false;
+  CompareOptions compare_options;
+  CLI::App* compare_cmd = app.add_subcommand(
+      "compare", "Compare two results CSVs row by row: throughput and ratio to Embree with a noise-aware verdict, "
+                 "deterministic columns exactly");
+  compare_cmd->add_option("base", compare_base, "Baseline results CSV")->required();
+  compare_cmd->add_option("current", compare_current, "Results CSV to compare with it")->required();
+  compare_cmd->add_option("--format,-f", compare_format, "table, md or json")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"table", "md", "json"}));
+  compare_cmd->add_option("--out,-o", compare_out, "Write to this file instead of stdout");
+  compare_cmd->add_flag("--force", compare_force, "Compare even when the machine metadata differ");
+  std::string compare_alpha = fmt::format("{}", compare_options.alpha),
+              compare_min_effect = fmt::format("{}", compare_options.min_effect);
+  compare_cmd->add_option("--alpha", compare_alpha, "Significance level of the Mann-Whitney U test")->capture_default_str()->type_name("FLOAT");
+  compare_cmd->add_option("--min-effect", compare_min_effect, "Smallest relative change that gets a verdict")
+      ->capture_default_str()->type_name("FLOAT");
+
+  // raybench gate
+  std::string gate_config = std::string(RAYBENCH_SOURCE_DIR) + "/results/gate.toml";
+  std::vector<std::string> gate_baselines, gate_currents;
+  bool gate_verbose = false;
+  CLI::App* gate_cmd = app.add_subcommand(
+      "gate", "Fail (exit 1) when the current results regress against a baseline beyond the thresholds of a gate config");
+  gate_cmd->add_option("--baseline", gate_baselines,
+                       "Baseline results CSV; give it more than once to pool independent runs of the baseline "
+                       "(each repetition keeps the ratio to Embree of its own run)")
+      ->required();
+  gate_cmd->add_option("--current", gate_currents,
+                       "Current results CSV; give it twice (two independent runs) to count a throughput "
+                       "regression only when both show it")
+      ->required();
+  gate_cmd->add_option("--config", gate_config, "Thresholds (TOML)")->capture_default_str();
+  gate_cmd->add_flag("--verbose,-v", gate_verbose, "Also print the full comparison table");
+
+  // raybench backends / scenes
+  CLI::App* backends_cmd = app.add_subcommand("backends", "List backend names");
+  std::string scenes_suite = kDefaultSuite;
+  CLI::App* scenes_cmd = app.add_subcommand("scenes", "List the suite's scenes and the procedural scenes");
+  scenes_cmd->add_option("--suite", scenes_suite, "Suite manifest")->capture_default_str();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "raybench: error: " << raybench::printable(e.what()) << " (see 'raybench --help')" << std::endl;
+    return 2;
+  }
+
+  if (*compare_cmd) {
+    compare_options.alpha = flag_value("--alpha", compare_alpha, alpha_setting);
+    compare_options.min_effect = flag_value("--min-effect", compare_min_effect, min_effect_setting);
+    check_input_file(compare_base, "results CSV");
+    check_input_file(compare_current, "results CSV");
+    check_outputs({output("--out", compare_out)},
+                  {{"base", compare_base, "base " + compare_base}, {"current", compare_current, "current " + compare_current}});
+    const ResultsFile base = read_results_file(compare_base);
+    const ResultsFile current = read_results_file(compare_current);
+    if (const auto diffs = machine_differences(base, current); !diffs.empty() && !compare_force) {
+      std::string all;
+      for (const auto& d : diffs) all += (all.empty() ? "" : "; ") + d;
+      throw InputError(compare_current, "not comparable with " + compare_base + ": " + all +
+                                            " (ratios to Embree still are: use --force to compare anyway)");
+    }
+    const Comparison c = compare_results(base, current, compare_options);
+    const OutputFormat format = compare_format == "md" ? OutputFormat::kMarkdown
+                                : compare_format == "json" ? OutputFormat::kJson
+                                                           : OutputFormat::kTable;
+    const bool colour = compare_out.empty() && format == OutputFormat::kTable && ::isatty(1);
+    const std::string text = format_comparison(c, base, current, format, colour);
+    if (compare_out.empty()) std::cout << text;
+    else write_file_atomically(compare_out, [&](std::ostream& o) { o << text; });
+    return 0;
+  }
+  if (*gate_cmd) {
+    check_input_file(gate_config, "gate config (TOML)");
+    for (const std::string& path : gate_baselines) check_input_file(path, "results CSV");
+    for (const std::string& path : gate_currents) check_input_file(path, "results CSV");
+    const GateConfig config = load_gate_config(gate_config);
+    std::vector<ResultsFile> baseline_runs;
+    for (const std::string& path : gate_baselines) baseline_runs.push_back(read_results_file(path));
+    const ResultsFile baseline = pool_runs(baseline_runs);
+    std::vector<ResultsFile> currents;
+    for (const std::string& path : gate_currents) {
+      currents.push_back(read_results_file(path));
+      if (currents.back().rows.empty()) throw InputError(path, "has no result rows");
+    }
+    const ResultsFile& current = currents.front();
+    const GateResult g = run_gate(baseline, currents, config);
+    if (gate_verbose) {
+      CompareOptions o;
+      o.alpha = config.alpha;
+      o.min_effect = config.max_ratio_drop;
+      std::cout << format_comparison(compare_results(baseline, current, o), baseline, current, OutputFormat::kTable,
+                                     ::isatty(1)) << "\n";
+    }
+    for (const auto& n : g.notes) std::cout << "note: " << n << "\n";
+    for (const auto& f : g.failures) std::cout << "FAIL: " << f << "\n";
+    std::cout << fmt::format("gate: {} ({} rows compared against {}, {} failure{})\n", g.failures.empty() ? "PASS" : "FAIL",
+                             current.rows.size(), baseline.path, g.failures.size(), g.failures.size() == 1 ? "" : "s");
+    return g.failures.empty() ? 0 : 1;
+  }
+  if (*accuracy_kernels_cmd) {
+    kernel_accuracy_options.rays = flag_value("--rays", kernel_accuracy_rays, kernel_rays_setting);
+    kernel_accuracy_options.seed = flag_value("--seed", kernel_accuracy_seed, seed_setting);
+    if (!kernel_accuracy_options.out_csv.empty())
+      check_outputs({output("--out", kernel_accuracy_options.out_csv), metadata_of("--out", kernel_accuracy_options.out_csv)});
+    check_output_folder("--rays-dir", kernel_accuracy_options.rays_dir);
+    kernel_accuracy_options.command_line = command_line(argc, argv);
+    const std::vector<AccuracyRow> rows = run_kernel_accuracy(kernel_accuracy_options);
+    std::cout << format_kernel_accuracy_table(rows);
+    fmt::print("results: {} ({} rows)\n", kernel_accuracy_options.out_csv, rows.size());
+    return 0;
+  }
+  if (*kernels_cmd) {
+    kernel_options.repetitions = flag_value("--reps", kernels_reps, repetitions_setting);
+    kernel_options.min_time = flag_value("--min-time", kernels_min_time, min_time_setting);
+    kernel_options.pairs = flag_value("--pairs", kernels_pairs, pairs_setting);
+    check_named("--out", kernel_options.out_csv);
+    check_outputs({output("--out", kernel_options.out_csv), metadata_of("--out", kernel_options.out_csv),
+                   output("--json", kernel_options.out_json)});
+    kernel_options.command_line = command_line(argc, argv);
+    const std::vector<KernelResult> results = run_kernel_benchmarks(kernel_options);
+    std::cout << format_kernel_table(results);
+    fmt::print("results: {} ({} rows){}\n", kernel_options.out_csv, results.size(),
+               kernel_options.out_json.empty() ? "" : ", Google Benchmark JSON: " + kernel_options.out_json);
+    return 0;
+  }
+  if (*backends_cmd) {
+    for (const BackendInfo& b : list_backends()) fmt::print("{:<20} {}\n", b.name, b.description);
+    return 0;
+  }
+  if (*scenes_cmd || (*run_cmd && list_only)) {
+    const Suite suite = load_suite(*scenes_cmd ? scenes_suite : suite_path);
+    fmt::print("suite {}:\n", suite.path);
+    for (const SuiteScene& s : suite.scenes)
+      fmt::print("  {:<18} {:<9} {}\n", s.name, s.available() ? "available" : "missing", s.path);
+    fmt::print("procedural scenes (use as proc:<name>):\n");
+    for (const ProceduralSceneInfo& p : procedural_scenes()) fmt::print("  {:<22} {}\n", p.name, p.description);
+    return 0;
+  }
+  if (*run_cmd) {
+    // Every flag is judged before the manifest is read or a scene loaded;
+    // a flag given overrides the manifest's value, whatever that value.
+    std::vector<std::function<void(SuiteSettings&)>> overrides;
+    const auto override_with = [&](const char* flag, const std::string& text, auto rule, auto member) {
+      if (run_cmd->count(flag)) overrides.push_back([member, v = flag_value(flag, text, rule)](SuiteSettings& s) { s.*member = v; });
+    };
+    if (!run_threads.empty()) {
+      std::vector<int> threads;
+      for (const std::string& t : run_threads) threads.push_back(flag_value("--threads", t, threads_setting));
+      overrides.push_back([threads](SuiteSettings& s) { s.threads = threads; });
+    }
+    override_with("--rays", run_rays, rays_setting, &SuiteSettings::rays);
+    override_with("--reps", run_reps, repetitions_setting, &SuiteSettings::repetitions);
+    override_with("--build-reps", run_build_reps, build_repetitions_setting, &SuiteSettings::build_repetitions);
+    override_with("--seed", run_seed, seed_setting, &SuiteSettings::seed);
+    override_with("--min-time", run_min_time, min_time_setting, &SuiteSettings::min_time);
+    override_with("--warmup", run_warmup, warmup_setting, &SuiteSettings::warmup);
+    check_named("--out", run_options.out_csv);
+    if (run_options.rays_dir.empty()) throw InputError("--rays-dir", "must name a folder, got ''");
+    check_outputs({output("--out", run_options.out_csv), metadata_of("--out", run_options.out_csv),
+                   output("--accuracy", run_options.accuracy_csv),
+                   run_options.accuracy_csv.empty() ? FileArg{} : metadata_of("--accuracy", run_options.accuracy_csv)},
+                  {{"--suite", suite_path, "--suite " + suite_path}});
+    check_output_folder("--rays-dir", run_options.rays_dir);
+
+    run_options.suite = load_suite(suite_path);
+    for (const std::string& name : run_options.scenes) {
+      // A scene given by path is named after its file's stem (scene.h), and
+      // that name goes into file names and the CSV like a manifest's: the
+      // same rule applies. Refused, not rewritten: a rewritten name could
+      // collide with another scene's.
+      if (run_options.suite.find(name) || name.rfind(kProceduralPrefix, 0) == 0) continue;
+      const std::string stem = std::filesystem::path(name).stem().string();
+      if (const std::string problem = scene_name_problem(stem); !problem.empty())
+        throw InputError("--scene", fmt::format("{}: its file name gives the scene name '{}', but {}; name the scene in "
+                                                "a suite manifest ([[scene]] name = \"...\", path = \"...\") and run it "
+                                                "with --suite",
+                                                printable(name), printable(stem), problem));
+    }
+    SuiteSettings& s = run_options.settings;
+    s = run_options.suite.settings;
+    if (!run_raysets.empty()) s.raysets = run_raysets;
+    run_options.raysets_from_command_line = !run_raysets.empty();
+    if (!run_backends.empty()) s.backends = run_backends;
+    for (const auto& apply : overrides) apply(s);
+    run_options.interleave = !no_interleave;
+    run_options.command_line = command_line(argc, argv);
+    const std::vector<ResultRow> rows = run_suite(run_options);
+    std::cout << format_results_table(rows) << std::endl;
+    fmt::print("results: {} ({} rows), metadata: {}\n", run_options.out_csv, rows.size(),
+               metadata_path_for(run_options.out_csv));
+    return 0;
+  }
+  if (*rays_cmd) {
+    const std::size_t count = flag_value("--count", rays_count, rays_setting);
+    const std::uint64_t seed = flag_value("--seed", rays_seed, seed_setting);
+    check_named("--out", rays_out);
+    check_outputs({output("--out", rays_out)}, {{"--scene", rays_scene, "--scene " + rays_scene}});
+    Suite storage;
+    const Suite* suite = suite_if_readable(rays_suite, rays_cmd->count("--suite") > 0, storage);
+    const RaySetKind kind = parse_rayset_kind(rays_kind);
+    const SceneArg s = resolve_scene(rays_scene, suite);
+    const RayGenerator generator(s.scene);
+    RaySetSpec spec{kind, count, seed, s.entry ? s.entry->camera : std::nullopt,
+                    s.entry ? s.entry->light : std::nullopt, s.entry ? s.entry->inside : std::nullopt};
+    const std::vector<Ray> rays = generator.generate(spec);
+    write_ray_file(rays_out, rays);
+    fmt::print("wrote {} {} rays for {} ({} triangles) to {}\n", rays.size(), rays_kind, s.scene.name,
+               s.scene.triangles.size(), rays_out);
+    return 0;
+  }
+  if (*trace_cmd) {
+    const int threads = flag_value("--threads", trace_threads, threads_setting);
+    check_input_file(trace_rays, "ray file (.npy)");
+    check_named("--out", trace_out);
+    check_outputs({output("--out", trace_out)},
+                  {{"--rays", trace_rays, "--rays " + trace_rays}, {"--scene", trace_scene, "--scene " + trace_scene}});
+    Suite storage;
+    const Suite* suite = suite_if_readable(trace_suite, trace_cmd->count("--suite") > 0, storage);
+    std::unique_ptr<Backend> backend = make_backend(trace_backend, {threads});
+    const std::vector<Ray> rays = read_ray_file(trace_rays);
+    const SceneArg s = resolve_scene(trace_scene, suite);
+    const TraceExecutor executor(threads);
+    executor.run([&] { backend->build(s.scene); });
+    std::size_t hits = 0;
+    if (trace_occluded) {
+      std::vector<std::uint8_t> occ(rays.size());
+      executor.occluded(*backend, rays, occ);
+      std::vector<double> out(occ.begin(), occ.end());
+      for (std::uint8_t o : occ) hits += o;
+      write_npy_f64(trace_out, out, rays.size(), 1);
+      fmt::print("occlusion query: {} of {} rays occluded; wrote (N, 1) occlusion flags (not hit records) to {}\n", hits,
+                 rays.size(), trace_out);
+    } else {
+      std::vector<Hit> h(rays.size());
+      executor.intersect(*backend, rays, h);
+      std::vector<double> out(rays.size() * 4);
+      for (std::size_t i = 0; i < h.size(); ++i) {
+        out[4 * i + 0] = h[i].t;
+        out[4 * i + 1] = h[i].prim;
+        out[4 * i + 2] = h[i].hit() ? h[i].u : 0.0;
+        out[4 * i + 3] = h[i].hit() ? h[i].v : 0.0;
+        hits += h[i].hit();
+      }
+      write_npy_f64(trace_out, out, rays.size(), 4);
+      fmt::print("closest hit: {} of {} rays hit; wrote (N, 4) t prim u v to {}\n", hits, rays.size(), trace_out);
+    }
+    return 0;
+  }
+  return 2;
+}
+
+}  // namespace
+}  // namespace raybench
+
+// Every error is one line (printable: a newline in a user's file or scene
+// name is written as \x0a), so scripts can take the last line of stderr.
+int main(int argc, char** argv) {
+  try {
+    raybench::record_source_state();  // the sources as built, before a long run
+    raybench::install_interrupt_handler();  // SIGINT/SIGTERM: temporary files removed, exit 130/143 (interrupt.h)
+    return raybench::run(argc, argv);
+  } catch (const raybench::InputError& e) {
+    std::cerr << "raybench: error: " << raybench::printable(e.what()) << std::endl;
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "raybench: error: out of memory" << std::endl;
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "raybench: error: " << raybench::printable(e.what()) << std::endl;
+    return 2;
+  }
+}

@@ -1,0 +1,112 @@
+// Ray sets: generated deterministically from (scene, kind, count, seed,
+// camera, light), stored as .npy, and traced identically by every backend.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "raybench/bvh/bvh2.h"
+#include "raybench/math/ray.h"
+#include "raybench/prim/triangle_mt.h"
+#include "scene/scene.h"
+
+namespace raybench {
+
+enum class RaySetKind {
+  kPrimary,
+  kDiffuse,
+  kShadow,
+  kUniform,
+  // Must-hit ray sets of ../shared/EXTREMES.md, for closed meshes that
+  // declare a ball inside them: every ray must hit, a miss is a leak.
+  kClosedInsideRandom,  // G01: origins in the ball, uniform directions
+  kSharedEdgeAimed,     // G02: origins in the ball, aimed at a float point of a random edge
+  kVertexAimed,         // G03: origins in the ball, aimed at a random vertex
+  // Extreme ray sets of ../shared/EXTREMES.md that need no inside ball.
+  kTinyTriangles,        // G05: aimed at interior points (10 % barycentric margin) of random triangles
+  kGrazing,              // G07: at 1e-2 ... 1e-6 rad to a random triangle's plane, aimed inside it
+  kDegenerateTriangles,  // G08: as G05; on zero-area triangles the aim point lies on the segment
+  kAxisParallel,         // G09: 26 sign/zero direction patterns with +0 and -0, origins on slab planes
+  kBehindOrigin,         // G14: a random triangle lies behind the origin (at t < 0)
+  kInvalid,              // G15: NaN or Inf in one field, NaN interval, tnear > tfar, d = 0, beyond Embree's range
+  kDirectionScaling,     // G16: uniform rays with |d| in 1e-20, 1e-7, 1, 1e7, 1e20
+  kBvhConservative,      // G17: from outside, aimed at vertices and float points of edges
+  kReintersection,       // G18: from primary hits, half into the normal hemisphere, half toward random points
+  kControlRandom,        // G20: origins uniform in the scene bounds, uniform directions
+  kFarOrigin,            // origins 1e5, 1e6, 1e7 units from the scene, aimed at random points of its bounds
+};
+
+// Which query a ray set is traced with.
+enum class Query { kIntersect, kOccluded };
+
+std::string to_string(RaySetKind kind);
+std::string to_string(Query query);
+// Throws InputError for an unknown name.
+RaySetKind parse_rayset_kind(const std::string& name);
+std::vector<std::string> rayset_kind_names();
+Query query_of(RaySetKind kind);
+// True for the must-hit kinds (G01-G03): they need RaySetSpec::inside.
+bool is_must_hit(RaySetKind kind);
+// True for rays that start on a surface (diffuse, shadow, reintersection):
+// they have a source triangle, and hitting it again is a self-intersection.
+bool has_sources(RaySetKind kind);
+
+// A pinhole camera; y is up unless `up` says otherwise.
+struct Camera {
+  Vec3f position, look_at, up{0, 1, 0};
+  float fov_degrees = 50.0f;  // horizontal
+  float aspect = 4.0f / 3.0f;
+};
+
+// A ball strictly inside a closed mesh: origins of the must-hit ray sets.
+struct InsideBall {
+  Vec3f center;
+  float radius = 0.0f;
+};
+
+struct RaySetSpec {
+  RaySetKind kind = RaySetKind::kPrimary;
+  std::size_t count = 0;
+  std::uint64_t seed = 1;
+  std::optional<Camera> camera;  // default: frames the scene's bounds from outside
+  std::optional<Vec3f> light;    // shadow rays' point light; default: above the scene
+  std::optional<InsideBall> inside{};  // required by the must-hit kinds
+};
+
+// Bumped whenever generation changes, so stored ray sets are never reused
+// across generator versions.
+inline constexpr int kRayGeneratorVersion = 3;
+
+// Makes ray sets for one scene. Diffuse and shadow rays start at primary
+// hits, found with our BVH2 (built once here).
+class RayGenerator {
+ public:
+  explicit RayGenerator(const Scene& scene);
+
+  // Throws InputError when the camera sees (almost) nothing of the scene, so
+  // that diffuse or shadow rays cannot be made.
+  // `sources`, when given, receives for every ray the triangle it starts
+  // from (secondary rays: diffuse, shadow, reintersection), or kNoHit.
+  std::vector<Ray> generate(const RaySetSpec& spec, std::vector<std::int32_t>* sources = nullptr) const;
+
+  Camera default_camera() const;
+  Vec3f default_light() const;
+  // A key over everything the rays depend on, for naming stored files.
+  std::uint64_t key(const RaySetSpec& spec) const;
+
+ private:
+  std::vector<Ray> primary(const RaySetSpec& spec, const Camera& camera) const;
+  std::vector<Ray> from_primary_hits(const RaySetSpec& spec, const Camera& camera, std::vector<std::int32_t>* sources) const;
+  std::vector<Ray> uniform(const RaySetSpec& spec) const;
+  std::vector<Ray> must_hit(const RaySetSpec& spec) const;
+  std::vector<Ray> extreme(const RaySetSpec& spec) const;
+
+  const Scene& scene_;
+  BBox bounds_;
+  Bvh2 bvh_;
+  std::vector<MollerTrumbore::Prepared> prepared_;
+};
+
+}  // namespace raybench

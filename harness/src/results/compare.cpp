@@ -1,0 +1,566 @@
+#include "results/compare.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <set>
+#include <string_view>
+#include <unordered_map>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "io/error.h"
+#include "measure/gbench.h"
+#include "io/input_file.h"
+#include "results/mann_whitney.h"
+#include "results/metadata.h"
+#include "results/results_csv.h"
+
+namespace raybench {
+namespace {
+
+using Row = std::map<std::string, std::string>;
+
+// How messages name a row: "scene/rayset/backend/threads:T".
+std::string row_key(const Row& r) {
+  return r.at("scene") + "/" + r.at("rayset") + "/" + r.at("backend") + "/threads:" + r.at("threads");
+}
+
+// A row's identity in the hash maps below: its fields joined by '\n', which
+// no field read from a CSV line holds, so two rows share a key only when all
+// four fields are equal (a '/' in a scene name could make row_key collide).
+std::string match_key(const Row& r) {
+  return r.at("scene") + '\n' + r.at("rayset") + '\n' + r.at("backend") + '\n' + r.at("threads");
+}
+// The key of the Embree row measured beside `r`: same scene, rayset, threads.
+std::string reference_key(const Row& r) {
+  return r.at("scene") + '\n' + r.at("rayset") + '\n' + "embree" + '\n' + r.at("threads");
+}
+bool is_reference(const Row& r) { return r.at("backend") == "embree"; }
+
+// Each row of a file by its match_key.
+class RowIndex {
+ public:
+  explicit RowIndex(const ResultsFile& f) : file_(f) {
+    index_.reserve(f.rows.size());
+    for (std::size_t i = 0; i < f.rows.size(); ++i) index_.emplace(match_key(f.rows[i]), i);
+  }
+  // The row with the same key as `like`, if any.
+  const Row* find(const Row& like) const { return at(match_key(like)); }
+  // The Embree row measured beside `row` in the same run, if any.
+  const Row* reference_beside(const Row& row) const { return at(reference_key(row)); }
+
+ private:
+  const Row* at(const std::string& key) const {
+    const auto it = index_.find(key);
+    return it == index_.end() ? nullptr : &file_.rows[it->second];
+  }
+  const ResultsFile& file_;
+  std::unordered_map<std::string, std::size_t> index_;
+};
+
+// The whole of `text` as a number, or nullopt ("12abc", "" and " 1" are not).
+std::optional<double> parse_number(std::string_view text) {
+  double v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size() || text.empty()) return std::nullopt;
+  return v;
+}
+
+// The ';'-separated samples of a row that read_results_file checked.
+std::vector<double> parse_samples(const std::string& text) {
+  std::vector<double> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(';', start), text.size());
+    out.push_back(parse_number(std::string_view(text).substr(start, end - start)).value_or(std::nan("")));
+    start = end + 1;
+  }
+  return out;
+}
+
+// "line 7 (scene/rayset/backend/threads:T)": a row as a user finds it in the file.
+std::string row_where(const ResultsFile& f, std::size_t i) {
+  return i < f.lines.size() ? fmt::format("line {} ({})", f.lines[i], row_key(f.rows[i])) : row_key(f.rows[i]);
+}
+
+// The rules of compare.h for one row; throws InputError naming the file,
+// the row and the column.
+void check_row(const ResultsFile& f, std::size_t i) {
+  const Row& r = f.rows[i];
+  const auto bad = [&](const std::string& column, const std::string& problem) {
+    return InputError(f.path, fmt::format("{}, column '{}': {}", row_where(f, i), column, problem));
+  };
+  const std::string& samples = r.at("mrays_s_samples");
+  if (samples.empty()) throw bad("mrays_s_samples", "empty: no throughput samples");
+  const std::vector<double> values = parse_samples(samples);
+  std::size_t start = 0;
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    const std::size_t end = std::min(samples.find(';', start), samples.size());
+    if (!(std::isfinite(values[k]) && values[k] > 0))
+      throw bad("mrays_s_samples", fmt::format("sample {} of {} is '{}', not a finite number > 0", k + 1, values.size(),
+                                               samples.substr(start, end - start)));
+    start = end + 1;
+  }
+  for (const char* column : {"agree_hit", "agree_prim"}) {
+    const std::string& text = r.at(column);
+    if (text.empty() && std::string_view(column) == "agree_prim" && r.at("query") == "occluded") continue;
+    const std::optional<double> v = parse_number(text);
+    if (!v || !(*v >= 0.0 && *v <= 1.0))
+      throw bad(column, text.empty() ? std::string("empty, expected a number in [0, 1]")
+                                     : fmt::format("'{}' is not a number in [0, 1]", text));
+  }
+  const std::string& leaks = r.at("leaks");
+  unsigned long long count = 0;
+  const auto [end, ec] = std::from_chars(leaks.data(), leaks.data() + leaks.size(), count);
+  if (!leaks.empty() && (ec != std::errc() || end != leaks.data() + leaks.size()))
+    throw bad("leaks", fmt::format("'{}' is not a count of rays (empty, or a whole number >= 0)", leaks));
+}
+
+// Throws InputError naming the first row of a backend other than Embree
+// without the Embree row of its scene, ray set and threads in the same file.
+void require_reference_rows(const ResultsFile& f) {
+  const RowIndex index(f);
+  for (std::size_t i = 0; i < f.rows.size(); ++i)
+    if (!is_reference(f.rows[i]) && !index.reference_beside(f.rows[i]))
+      throw InputError(f.path, fmt::format("{}: no embree row for {}/{}/threads:{}: a baseline needs the embree "
+                                           "backend's rows, the reference of every ratio the gate checks",
+                                           row_where(f, i), f.rows[i].at("scene"), f.rows[i].at("rayset"),
+                                           f.rows[i].at("threads")));
+}
+
+// The columns that are a pure function of the rays, the scene and the code.
+const std::vector<std::string>& deterministic_columns() {
+  static const std::vector<std::string> c = {"triangles",     "hit_rate",     "agree_hit",      "agree_prim",
+                                             "prim_ties",     "t_relerr_max", "t_relerr_p999", "disagreements",
+                                             "leaks",         "memory_bytes"};
+  return c;
+}
+
+Verdict decide(double change, double p, const CompareOptions& o) {
+  if (std::fabs(change) < o.min_effect) return Verdict::kSame;
+  if (p >= o.alpha) return Verdict::kUnsure;
+  return change > 0 ? Verdict::kFaster : Verdict::kSlower;
+}
+
+SampleComparison compare_samples(const std::vector<double>& base, const std::vector<double>& current,
+                                 const CompareOptions& o) {
+  SampleComparison c;
+  if (base.empty() || current.empty()) return c;
+  c.base = median(base);
+  c.current = median(current);
+  c.change = c.base > 0 ? c.current / c.base - 1.0 : 0.0;
+  c.p_value = mann_whitney_u(current, base).p_value;
+  c.verdict = decide(c.change, c.p_value, o);
+  return c;
+}
+
+// Each repetition of a row divided by the median of the Embree row measured
+// in the same run (same scene, ray set, threads); empty without one.
+std::vector<double> ratio_samples(const RowIndex& index, const Row& row) {
+  if (is_reference(row)) return {};
+  const Row* e = index.reference_beside(row);
+  if (!e) return {};
+  const double reference = median(parse_samples(e->at("mrays_s_samples")));
+  if (!(reference > 0)) return {};
+  std::vector<double> out = parse_samples(row.at("mrays_s_samples"));
+  for (double& v : out) v /= reference;
+  return out;
+}
+
+std::string percent(double change) { return fmt::format("{:+.1f}%", 100.0 * change); }
+
+// A JSON string literal (RFC 8259: quote, backslash and control characters escaped).
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (static_cast<unsigned char>(c) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      continue;
+    }
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "null"; }
+
+}  // namespace
+
+ResultsFile read_results_file(const std::string& path) {
+  ResultsFile f;
+  f.path = path;
+  check_input_file(path, "results file");
+  f.rows = read_results_csv(path, &f.lines);
+  if (f.rows.empty()) throw InputError(path, "no result rows (only a header): nothing to compare");
+  std::unordered_map<std::string, std::size_t> seen;
+  seen.reserve(f.rows.size());
+  for (std::size_t i = 0; i < f.rows.size(); ++i) {
+    check_row(f, i);
+    const auto [it, fresh] = seen.emplace(match_key(f.rows[i]), i);
+    if (!fresh)
+      throw InputError(path, fmt::format("{} repeats line {}: each (scene, rayset, backend, threads) may appear once",
+                                         row_where(f, i), f.lines.at(it->second)));
+  }
+  const std::string meta = metadata_path_for(path);
+  std::error_code ec;
+  if (std::filesystem::exists(meta, ec)) {
+    check_input_file(meta, "results metadata");
+    try {
+      const toml::table t = toml::parse_file(meta);
+      for (const auto& [key, value] : t)
+        if (auto s = value.value<std::string>()) f.metadata[std::string(key.str())] = *s;
+    } catch (const toml::parse_error& e) {
+      throw InputError(meta, fmt::format("line {}: {}", e.source().begin.line, e.description()));
+    }
+  }
+  // A file without `status` is from a run older than partial files: complete.
+  if (const auto status = f.metadata.find("status"); status != f.metadata.end()) {
+    if (status->second == "partial") {
+      const auto progress = f.metadata.find("progress");
+      f.partial.push_back({path, progress == f.metadata.end() ? "" : progress->second});
+    } else if (status->second != "complete") {
+      throw InputError(meta, fmt::format("'status': '{}', expected \"partial\" or \"complete\"", status->second));
+    }
+  }
+  return f;
+}
+
+std::vector<std::string> partial_notes(const ResultsFile& f) {
+  std::vector<std::string> out;
+  for (const PartialFile& p : f.partial)
+    out.push_back(fmt::format("{} is partial ({}): its run was interrupted or is still going, so the rows of its "
+                              "unfinished scenes are missing",
+                              p.path, p.progress.empty() ? "progress unknown" : p.progress));
+  return out;
+}
+
+ResultsFile pool_runs(const std::vector<ResultsFile>& runs) {
+  if (runs.empty()) throw InputError("", "no results to pool");
+  for (const ResultsFile& run : runs) require_reference_rows(run);
+  ResultsFile pooled = runs.front();
+  if (runs.size() == 1) return pooled;
+  std::vector<RowIndex> indexes;
+  indexes.reserve(runs.size());
+  for (const ResultsFile& run : runs) indexes.emplace_back(run);
+  for (std::size_t i = 1; i < runs.size(); ++i) {
+    pooled.path += " + " + runs[i].path;
+    pooled.partial.insert(pooled.partial.end(), runs[i].partial.begin(), runs[i].partial.end());
+  }
+  for (auto& row : pooled.rows) {
+    // Every run's own Embree median for this row, and the pooled one.
+    std::vector<double> reference_per_run, all_reference;
+    for (const RowIndex& index : indexes) {
+      const Row* e = index.reference_beside(row);
+      const std::vector<double> s = e ? parse_samples(e->at("mrays_s_samples")) : std::vector<double>{};
+      reference_per_run.push_back(s.empty() ? 0.0 : median(s));
+      all_reference.insert(all_reference.end(), s.begin(), s.end());
+    }
+    const double pooled_reference = all_reference.empty() ? 0.0 : median(all_reference);
+    std::string samples;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      const Row* r = indexes[i].find(row);
+      if (!r) continue;
+      const bool rescale = !is_reference(row) && reference_per_run[i] > 0 && pooled_reference > 0;
+      for (double v : parse_samples(r->at("mrays_s_samples")))
+        samples += fmt::format("{}{:.9g}", samples.empty() ? "" : ";",
+                               rescale ? v * pooled_reference / reference_per_run[i] : v);
+    }
+    row["mrays_s_samples"] = samples;
+  }
+  return pooled;
+}
+
+const std::vector<std::string>& machine_keys() {
+  static const std::vector<std::string> keys = {"cpu", "hardware_threads", "compiler", "flags", "build_type", "embree"};
+  return keys;
+}
+
+std::vector<std::string> machine_differences(const ResultsFile& base, const ResultsFile& current) {
+  std::vector<std::string> out;
+  if (base.metadata.empty()) out.push_back("no metadata beside " + base.path);
+  if (current.metadata.empty()) out.push_back("no metadata beside " + current.path);
+  if (!out.empty()) return out;
+  for (const std::string& k : machine_keys()) {
+    const auto b = base.metadata.find(k), c = current.metadata.find(k);
+    const std::string bv = b == base.metadata.end() ? "(missing)" : b->second;
+    const std::string cv = c == current.metadata.end() ? "(missing)" : c->second;
+    if (bv != cv) out.push_back(fmt::format("{}: '{}' vs '{}'", k, bv, cv));
+  }
+  return out;
+}
+
+std::string to_string(Verdict v) {
+  switch (v) {
+    case Verdict::kSame: return "same";
+    case Verdict::kFaster: return "faster";
+    case Verdict::kSlower: return "slower";
+    case Verdict::kUnsure: return "unsure";
+    case Verdict::kNotApplicable: return "-";
+  }
+  return "?";
+}
+
+Comparison compare_results(const ResultsFile& base, const ResultsFile& current, const CompareOptions& options) {
+  Comparison c;
+  const RowIndex base_index(base), current_index(current);
+  for (const auto& b : base.rows) {
+    const Row* n = current_index.find(b);
+    if (!n) {
+      c.only_in_base.push_back(row_key(b));
+      continue;
+    }
+    RowComparison rc;
+    rc.scene = b.at("scene");
+    rc.rayset = b.at("rayset");
+    rc.backend = b.at("backend");
+    rc.threads = b.at("threads");
+    rc.base_row = &b;
+    rc.current_row = n;
+    rc.same_rays = b.at("rays") == n->at("rays");
+    if (rc.same_rays) {
+      rc.throughput = compare_samples(parse_samples(b.at("mrays_s_samples")), parse_samples(n->at("mrays_s_samples")), options);
+      rc.ratio = compare_samples(ratio_samples(base_index, b), ratio_samples(current_index, *n), options);
+      for (const std::string& col : deterministic_columns())
+        if (b.at(col) != n->at(col)) rc.changes.push_back({col, b.at(col), n->at(col)});
+    }
+    c.rows.push_back(std::move(rc));
+  }
+  for (const auto& r : current.rows)
+    if (!base_index.find(r)) c.only_in_current.push_back(row_key(r));
+  return c;
+}
+
+std::string format_comparison(const Comparison& c, const ResultsFile& base, const ResultsFile& current,
+                              OutputFormat format, bool colour) {
+  const auto paint = [&](Verdict v, const std::string& text) {
+    if (!colour) return text;
+    if (v == Verdict::kSlower) return "\033[31m" + text + "\033[0m";
+    if (v == Verdict::kFaster) return "\033[32m" + text + "\033[0m";
+    if (v == Verdict::kUnsure) return "\033[33m" + text + "\033[0m";
+    return text;
+  };
+  std::vector<std::string> notes = partial_notes(base);
+  for (const std::string& n : partial_notes(current)) notes.push_back(n);
+  const auto changes_text = [](const RowComparison& r) {
+    if (!r.same_rays) return std::string("different ray counts: not compared");
+    std::string s;
+    for (const auto& ch : r.changes)
+      s += (s.empty() ? "" : "; ") + ch.column + " " + (ch.base.empty() ? "-" : ch.base) + " -> " + (ch.current.empty() ? "-" : ch.current);
+    return s;
+  };
+  std::string out;
+  if (format == OutputFormat::kJson) {
+    out += "{\n  \"base\": " + json_string(base.path) + ",\n  \"current\": " + json_string(current.path) + ",\n  \"rows\": [\n";
+    for (std::size_t i = 0; i < c.rows.size(); ++i) {
+      const RowComparison& r = c.rows[i];
+      std::string changes;
+      for (const auto& ch : r.changes)
+        changes += (changes.empty() ? "" : ", ") + fmt::format("{{\"column\": {}, \"base\": {}, \"current\": {}}}",
+                                                               json_string(ch.column), json_string(ch.base), json_string(ch.current));
+      const auto sample = [&](const SampleComparison& s) {
+        return fmt::format("{{\"base\": {}, \"current\": {}, \"change\": {}, \"p_value\": {}, \"verdict\": {}}}",
+                           json_number(s.base), json_number(s.current), json_number(s.change), json_number(s.p_value),
+                           json_string(to_string(s.verdict)));
+      };
+      out += fmt::format(
+          "    {{\"scene\": {}, \"rayset\": {}, \"backend\": {}, \"threads\": {}, \"same_rays\": {}, \"mrays_s\": {}, "
+          "\"ratio_to_embree\": {}, \"changes\": [{}]}}{}\n",
+          json_string(r.scene), json_string(r.rayset), json_string(r.backend), r.threads, r.same_rays ? "true" : "false",
+          sample(r.throughput), sample(r.ratio), changes, i + 1 < c.rows.size() ? "," : "");
+    }
+    const auto list = [&](const std::vector<std::string>& v) {
+      std::string s;
+      for (const auto& e : v) s += (s.empty() ? "" : ", ") + json_string(e);
+      return "[" + s + "]";
+    };
+    out += "  ],\n  \"only_in_base\": " + list(c.only_in_base) + ",\n  \"only_in_current\": " + list(c.only_in_current) +
+           ",\n  \"notes\": " + list(notes) + "\n}\n";
+    return out;
+  }
+  const bool md = format == OutputFormat::kMarkdown;
+  std::vector<std::vector<std::string>> table;
+  table.push_back({"scene", "rayset", "backend", "thr", "Mrays/s base", "current", "change", "p", "verdict", "x embree",
+                   "change", "p", "verdict", "deterministic changes"});
+  std::vector<std::vector<Verdict>> verdicts;
+  for (const RowComparison& r : c.rows) {
+    const auto& t = r.throughput;
+    const auto& q = r.ratio;
+    const bool has_ratio = q.verdict != Verdict::kNotApplicable;
+    table.push_back({r.scene, r.rayset, r.backend, r.threads, fmt::format("{:.2f}", t.base), fmt::format("{:.2f}", t.current),
+                     percent(t.change), fmt::format("{:.3g}", t.p_value), to_string(t.verdict),
+                     has_ratio ? fmt::format("{:.3f} -> {:.3f}", q.base, q.current) : "-",
+                     has_ratio ? percent(q.change) : "-", has_ratio ? fmt::format("{:.3g}", q.p_value) : "-",
+                     to_string(q.verdict), changes_text(r)});
+  }
+  std::vector<std::size_t> width(table[0].size(), 0);
+  for (const auto& row : table)
+    for (std::size_t i = 0; i < row.size(); ++i) width[i] = std::max(width[i], row[i].size());
+  for (std::size_t ri = 0; ri < table.size(); ++ri) {
+    const auto& row = table[ri];
+    const Verdict tv = ri ? c.rows[ri - 1].throughput.verdict : Verdict::kSame;
+    const Verdict qv = ri ? c.rows[ri - 1].ratio.verdict : Verdict::kSame;
+    std::string line = md ? "|" : "";
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      std::string cell = md ? " " + row[i] + " |" : fmt::format("{:<{}}", row[i], width[i]) + (i + 1 < row.size() ? "  " : "");
+      if (!md && (i == 8)) cell = paint(tv, cell);
+      if (!md && (i == 12)) cell = paint(qv, cell);
+      line += cell;
+    }
+    while (!md && !line.empty() && line.back() == ' ') line.pop_back();
+    out += line + "\n";
+    if (md && ri == 0) {
+      out += "|";
+      for (std::size_t i = 0; i < row.size(); ++i) out += "---|";
+      out += "\n";
+    }
+  }
+  if (!c.only_in_base.empty()) out += (md ? "\n**Only in " : "\nonly in ") + base.path + (md ? "**: " : ": ") + fmt::format("{}", fmt::join(c.only_in_base, ", ")) + "\n";
+  if (!c.only_in_current.empty()) out += (md ? "\n**Only in " : "\nonly in ") + current.path + (md ? "**: " : ": ") + fmt::format("{}", fmt::join(c.only_in_current, ", ")) + "\n";
+  for (const std::string& n : notes) out += (md ? "\n**Note**: " : "\nnote: ") + n + "\n";
+  return out;
+}
+
+GateConfig load_gate_config(const std::string& path) {
+  GateConfig g;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "no such gate config");
+  toml::table t;
+  try {
+    t = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    throw InputError(path, fmt::format("line {}: {}", e.source().begin.line, e.description()));
+  }
+  const std::set<std::string> known = {"max_ratio_drop", "alpha", "max_agree_hit_drop", "max_agree_prim_drop",
+                                       "min_agree_hit", "no_new_leaks", "fail_on_missing_rows"};
+  for (const auto& [key, value] : t)
+    if (!known.count(std::string(key.str()))) throw InputError(path, fmt::format("'{}': unknown key", key.str()));
+  const auto number = [&](const char* key, double& out, double lo, double hi) {
+    if (const toml::node* n = t.get(key)) {
+      const auto v = n->value<double>();
+      if (!v || !(*v >= lo && *v <= hi)) throw InputError(path, fmt::format("'{}': expected a number in [{}, {}]", key, lo, hi));
+      out = *v;
+    }
+  };
+  number("max_ratio_drop", g.max_ratio_drop, 0.0, 1.0);
+  number("alpha", g.alpha, 0.0, 1.0);
+  number("max_agree_hit_drop", g.max_agree_hit_drop, 0.0, 1.0);
+  number("max_agree_prim_drop", g.max_agree_prim_drop, 0.0, 1.0);
+  number("min_agree_hit", g.min_agree_hit, 0.0, 1.0);
+  if (const toml::node* n = t.get("no_new_leaks")) {
+    const toml::array* a = n->as_array();
+    if (!a) throw InputError(path, "'no_new_leaks': expected an array of backend-name substrings");
+    g.no_new_leaks.clear();
+    for (const toml::node& e : *a) {
+      auto s = e.value<std::string>();
+      if (!s) throw InputError(path, "'no_new_leaks': expected an array of backend-name substrings");
+      g.no_new_leaks.push_back(*s);
+    }
+  }
+  if (const toml::node* n = t.get("fail_on_missing_rows")) {
+    const auto v = n->value<bool>();
+    if (!v) throw InputError(path, "'fail_on_missing_rows': expected true or false");
+    g.fail_on_missing_rows = *v;
+  }
+  return g;
+}
+
+GateResult run_gate(const ResultsFile& baseline, const std::vector<ResultsFile>& currents, const GateConfig& config) {
+  GateResult g;
+  require_reference_rows(baseline);
+  CompareOptions o;
+  o.alpha = config.alpha;
+  o.min_effect = config.max_ratio_drop;
+  const ResultsFile& current = currents.at(0);
+  const Comparison c = compare_results(baseline, current, o);
+  // Rows whose ratio to Embree fell significantly in every other run too.
+  struct Confirmation {
+    Comparison comparison;
+    std::unordered_map<std::string, std::size_t> by_key;  // match_key -> index in comparison.rows
+  };
+  std::vector<Confirmation> confirmations;
+  for (std::size_t i = 1; i < currents.size(); ++i) {
+    Confirmation& k = confirmations.emplace_back(Confirmation{compare_results(baseline, currents[i], o), {}});
+    for (std::size_t j = 0; j < k.comparison.rows.size(); ++j) k.by_key.emplace(match_key(*k.comparison.rows[j].base_row), j);
+  }
+  const auto confirmed = [&](const RowComparison& r, std::string& also) {
+    for (const Confirmation& other : confirmations) {
+      const auto it = other.by_key.find(match_key(*r.base_row));
+      if (it == other.by_key.end() || other.comparison.rows[it->second].ratio.verdict != Verdict::kSlower) return false;
+      also += fmt::format(", confirmed by another run: {:.3f}", other.comparison.rows[it->second].ratio.current);
+    }
+    return true;
+  };
+  for (const std::string& n : partial_notes(baseline)) g.notes.push_back(n);
+  for (const ResultsFile& run : currents)
+    for (const std::string& n : partial_notes(run)) g.notes.push_back(n);
+  for (const std::string& d : machine_differences(baseline, current))
+    g.notes.push_back("machine differs (" + d + "): gating on ratios to Embree and deterministic columns only");
+  if (config.fail_on_missing_rows)
+    for (const std::string& k : c.only_in_base) g.failures.push_back(k + ": in the baseline but not in the current run");
+  // A baseline row measured in a current run without its Embree row: its
+  // ratio to Embree, what the gate checks, cannot be computed there.
+  for (const ResultsFile& run : currents) {
+    const RowIndex index(run);
+    for (const Row& b : baseline.rows)
+      if (!is_reference(b) && index.find(b) && !index.reference_beside(b))
+        g.failures.push_back(fmt::format("{}: no embree row for {}/{}/threads:{} in {}: its ratio to Embree cannot be checked",
+                                         row_key(b), b.at("scene"), b.at("rayset"), b.at("threads"), run.path));
+  }
+  // A numeric column of the baseline's (from_base) or the current run's row;
+  // NaN when empty ("not applicable"). read_results_file checked the values.
+  const auto number_in = [&](const RowComparison& rc, bool from_base, const char* col) {
+    return parse_number((from_base ? rc.base_row : rc.current_row)->at(col)).value_or(std::nan(""));
+  };
+  for (const RowComparison& r : c.rows) {
+    const std::string key = row_key(*r.base_row);
+    if (!r.same_rays) {
+      g.failures.push_back(key + ": ray count differs from the baseline (" + r.base_row->at("rays") + " vs " +
+                           r.current_row->at("rays") + "); regenerate the baseline");
+      continue;
+    }
+    std::string also;
+    if (r.ratio.verdict == Verdict::kSlower && confirmed(r, also))
+      g.failures.push_back(fmt::format("{}: ratio to Embree fell {:.1f}% ({:.3f} -> {:.3f}, p = {:.2g}{}; limit {:.0f}%)", key,
+                                       -100.0 * r.ratio.change, r.ratio.base, r.ratio.current, r.ratio.p_value, also,
+                                       100.0 * config.max_ratio_drop));
+    else if (r.ratio.verdict == Verdict::kSlower)
+      g.notes.push_back(fmt::format("{}: ratio to Embree fell {:.1f}% in one run but not in the confirming run: noise",
+                                    key, -100.0 * r.ratio.change));
+    else if (r.ratio.verdict == Verdict::kUnsure && r.ratio.change < 0)
+      g.notes.push_back(fmt::format("{}: ratio to Embree {:+.1f}% but not significant (p = {:.2g})", key,
+                                    100.0 * r.ratio.change, r.ratio.p_value));
+    // A value the baseline recorded and the current run does not (only an
+    // occluded row may leave agree_prim empty, so the query changed).
+    for (const char* col : {"agree_hit", "agree_prim", "leaks"})
+      if (!std::isnan(number_in(r, true, col)) && std::isnan(number_in(r, false, col)))
+        g.failures.push_back(fmt::format("{}: {} is empty in the current run (baseline {})", key, col, r.base_row->at(col)));
+    const double hit_drop = number_in(r, true, "agree_hit") - number_in(r, false, "agree_hit");
+    if (hit_drop > config.max_agree_hit_drop)
+      g.failures.push_back(fmt::format("{}: agree_hit fell by {:.6f} ({} -> {}; limit {})", key, hit_drop,
+                                       r.base_row->at("agree_hit"), r.current_row->at("agree_hit"), config.max_agree_hit_drop));
+    const double prim_drop = number_in(r, true, "agree_prim") - number_in(r, false, "agree_prim");
+    if (prim_drop > config.max_agree_prim_drop)
+      g.failures.push_back(fmt::format("{}: agree_prim fell by {:.6f} ({} -> {}; limit {})", key, prim_drop,
+                                       r.base_row->at("agree_prim"), r.current_row->at("agree_prim"), config.max_agree_prim_drop));
+    const bool seed_faithful = r.backend.find("_seed") != std::string::npos;
+    const double agree_hit = number_in(r, false, "agree_hit");
+    const bool must_hit = !r.current_row->at("leaks").empty();
+    if (!seed_faithful && !must_hit && agree_hit < config.min_agree_hit)
+      g.failures.push_back(fmt::format("{}: agree_hit {} is below the floor {}", key, r.current_row->at("agree_hit"),
+                                       config.min_agree_hit));
+    for (const std::string& pattern : config.no_new_leaks) {
+      if (r.backend.find(pattern) == std::string::npos || !must_hit) continue;
+      const double before = number_in(r, true, "leaks"), after = number_in(r, false, "leaks");
+      if (after > (std::isnan(before) ? 0.0 : before))
+        g.failures.push_back(fmt::format("{}: new leaks: {} rays miss a closed mesh from inside (baseline {})", key,
+                                         r.current_row->at("leaks"), r.base_row->at("leaks").empty() ? "-" : r.base_row->at("leaks")));
+    }
+  }
+  return g;
+}
+
+}  // namespace raybench

@@ -1,0 +1,57 @@
+// A scene as every backend receives it: one flat array of triangles.
+//
+// Order (documented in README.md, "Scenes"): the file's node hierarchy is
+// walked depth first, parent before children, children in file order; at each
+// node its meshes in the node's order; in each mesh its faces in file order,
+// polygons fan-triangulated by assimp. Node transforms are applied. Degenerate
+// triangles are kept. A triangle's index in this array is its `prim` id.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "raybench/math/bbox.h"
+#include "raybench/prim/triangle.h"
+
+namespace raybench {
+
+struct Scene {
+  std::string name;    // short name used in results (file stem, or the manifest's name)
+  std::string source;  // the path or procedural spec it was made from
+  std::vector<Triangle> triangles;
+  std::size_t skipped_points = 0;  // point primitives in the file, not traced
+  std::size_t skipped_lines = 0;   // line primitives in the file, not traced
+
+  BBox bounds() const;
+  // A hash of the triangle data: stored ray sets are keyed by it, so a changed
+  // mesh never reuses rays made for its old version.
+  std::uint64_t content_hash() const;
+};
+
+// Loads a mesh file with assimp, or builds a procedural scene when `spec`
+// starts with "proc:" (see procedural.h). Throws InputError naming the file
+// on a missing, unreadable or malformed file, one without triangles, or one
+// that check_scene_coordinates refuses. assimp runs in a child process with
+// a deadline (RAYBENCH_LOAD_TIMEOUT, see scene_assimp.cpp): a crash or hang
+// of it is such an error too.
+Scene load_scene(const std::string& spec);
+
+// The largest coordinate magnitude a scene's vertices may have. Box surface
+// areas, which every BVH builder and the collapse compute in float, must stay
+// finite: a box within +-B has extents up to 2B and surface area up to
+// 2 * 3 * (2B)^2 = 24 B^2, finite while B <= sqrt(FLT_MAX / 24) = 3.7e18.
+// 1e18 keeps the scene box's area (2.4e37) a factor 14 below FLT_MAX.
+// Coordinates of +-1e19 overflowed the wide BVH's collapse (issue 28).
+inline constexpr float kMaxSceneCoordinate = 1e18f;
+
+// Throws InputError(where, ...) when a vertex of `scene` is not finite or
+// has a coordinate beyond +-kMaxSceneCoordinate; `where` names the file or
+// the manifest's scene. load_scene runs it on what the file holds, and
+// load_suite_scene (suite.h) again after the manifest's scale and offset,
+// on the vertices as they will be traced.
+void check_scene_coordinates(const Scene& scene, const std::string& where);
+
+}  // namespace raybench

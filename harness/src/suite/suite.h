@@ -1,0 +1,61 @@
+// A suite manifest (TOML, e.g. meshes/default.toml): which scenes, ray sets,
+// backends and settings a run uses. See README.md, "Suite manifests".
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rays/rayset.h"
+
+namespace raybench {
+
+struct SuiteScene {
+  std::string name;  // used in results and on the command line
+  std::string path;  // resolved against the manifest's folder; or "proc:<name>"
+  bool optional = false;  // skipped with a note when the file is absent
+  std::optional<Camera> camera;
+  std::optional<Vec3f> light;
+  std::optional<InsideBall> inside;  // a closed mesh's inner ball: enables the must-hit ray sets
+  std::vector<std::string> raysets;  // this scene's ray sets; empty: the suite's defaults
+  // Every vertex v becomes float(scale * v + offset) after loading; camera,
+  // light and inside ball (given for the untransformed scene) move with it.
+  double scale = 1.0;
+  std::array<double, 3> offset{0.0, 0.0, 0.0};
+
+  bool available() const;
+  bool transformed() const { return scale != 1.0 || offset != std::array<double, 3>{0.0, 0.0, 0.0}; }
+};
+
+// Loads the scene an entry names, transformed and named as the entry says.
+Scene load_suite_scene(const SuiteScene& entry);
+
+struct SuiteSettings {
+  std::size_t rays = 262144;
+  std::vector<std::string> raysets{"primary", "diffuse", "shadow", "uniform"};
+  std::vector<std::string> backends{"embree", "bvh2"};
+  std::vector<int> threads{1};
+  int repetitions = 5;
+  int build_repetitions = 3;
+  std::uint64_t seed = 1;
+  double min_time = 0.05;  // seconds per repetition (Google Benchmark's min time)
+  double warmup = 0.05;    // seconds of untimed warm-up per case
+};
+
+struct Suite {
+  std::string path;
+  SuiteSettings settings;
+  std::vector<SuiteScene> scenes;
+
+  // The scene called `name`, or nullptr.
+  const SuiteScene* find(const std::string& name) const;
+};
+
+// Throws InputError naming the file and key on syntax errors, unknown keys,
+// wrong types or duplicate scene names. A [[scene]] with a `sweep` table
+// (scales, offsets) becomes one scene per combination: the stability sweep.
+Suite load_suite(const std::string& path);
+
+}  // namespace raybench

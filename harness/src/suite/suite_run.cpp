@@ -1,0 +1,433 @@
+#include "suite/suite_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <new>
+#include <optional>
+#include <stdexcept>
+
+#include <benchmark/benchmark.h>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "accuracy/judge.h"
+#include "measure/agreement.h"
+#include "io/atomic_file.h"
+#include "backends/backend.h"
+#include "measure/build_timing.h"
+#include "io/error.h"
+#include "measure/gbench.h"
+#include "io/interrupt.h"
+#include "results/metadata.h"
+#include "io/npy.h"
+#include "rays/rayset.h"
+#include "referee/referee.h"
+#include "scene/scene.h"
+#include "suite/settings_rules.h"
+#include "measure/trace.h"
+
+namespace raybench {
+namespace {
+
+void progress(const std::string& line) { std::cerr << "raybench: " << line << std::endl; }
+
+struct LoadedScene {
+  const SuiteScene* entry = nullptr;  // null for a scene given by path
+  Scene scene;
+};
+
+struct RaySet {
+  RaySetKind kind;
+  std::vector<Ray> rays;
+  std::vector<std::int32_t> sources;   // accuracy runs, secondary rays: the triangle each starts from
+  std::vector<RefereeVerdict> truth;   // accuracy runs: the referee's verdict per ray
+};
+
+// Rays are stored under a name that carries everything they depend on, so a
+// later run (or a later commit) traces exactly the same rays.
+// With `sources`, the rays are made again (bit-identical) to learn where
+// each secondary ray starts; they are not stored in the ray file.
+std::vector<Ray> obtain_rays(const RayGenerator& generator, const Scene& scene, const RaySetSpec& spec,
+                             const std::string& rays_dir, std::vector<std::int32_t>* sources = nullptr) {
+  if (const std::string problem = scene_name_problem(scene.name); !problem.empty()) throw InputError(printable(scene.name), problem);
+  const std::string path = fmt::format("{}/{}.{}.n{}.{:016x}.npy", rays_dir, scene.name, to_string(spec.kind),
+                                       spec.count, generator.key(spec));
+  std::error_code ec;
+  if (!sources && std::filesystem::exists(path, ec)) {
+    try {
+      std::vector<Ray> rays = read_ray_file(path);
+      if (rays.size() == spec.count) {
+        progress(fmt::format("  {} rays: reusing {}", to_string(spec.kind), path));
+        return rays;
+      }
+    } catch (const InputError& e) {
+      progress(fmt::format("  warning: stored ray set unusable, regenerating ({})", e.what()));
+    }
+  }
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<Ray> rays = generator.generate(spec, sources);
+  write_ray_file(path, rays);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  progress(fmt::format("  {} rays: generated {} in {:.0f} ms -> {}", to_string(spec.kind), rays.size(), ms, path));
+  return rays;
+}
+
+LoadedScene load(const RunOptions& options, const std::string& name_or_path) {
+  LoadedScene loaded;
+  loaded.entry = options.suite.find(name_or_path);
+  loaded.scene = loaded.entry ? load_suite_scene(*loaded.entry) : load_scene(name_or_path);
+  return loaded;
+}
+
+struct SceneResults {
+  std::vector<ResultRow> rows;
+  std::vector<AccuracyRow> accuracy;  // runs with RunOptions::accuracy_csv only
+};
+
+// One scene, scene `index` of `count`: its ray sets (made or reused), the
+// referee's verdicts (accuracy runs), every backend built, agreement with the
+// reference, and the timing of every case. No rows when no ray set applies.
+SceneResults measure_scene(const RunOptions& options, const LoadedScene& loaded, std::size_t index, std::size_t count) {
+  const Scene& scene = loaded.scene;
+  const SuiteScene* entry = loaded.entry;
+  const SuiteSettings& settings = options.settings;
+  SceneResults results;
+  progress(fmt::format("[{}/{}] {}: ray sets", index + 1, count, scene.name));
+  std::vector<RaySet> raysets;
+  {
+    const RayGenerator generator(scene);
+    const std::vector<std::string>& names =
+        options.raysets_from_command_line || !entry || entry->raysets.empty() ? settings.raysets : entry->raysets;
+    for (const std::string& name : names) {
+      const RaySetKind kind = parse_rayset_kind(name);
+      const std::optional<InsideBall> inside = entry ? entry->inside : std::nullopt;
+      if (is_must_hit(kind) && !inside) {
+        progress(fmt::format("  {}: skipped, the scene declares no inside ball (closed meshes only)", name));
+        continue;
+      }
+      RaySetSpec spec{kind, settings.rays, settings.seed, entry ? entry->camera : std::nullopt,
+                      entry ? entry->light : std::nullopt, inside};
+      RaySet set{kind, {}, {}, {}};
+      const bool want_sources = !options.accuracy_csv.empty() && has_sources(kind);
+      set.rays = obtain_rays(generator, scene, spec, options.rays_dir, want_sources ? &set.sources : nullptr);
+      raysets.push_back(std::move(set));
+    }
+  }
+  std::unique_ptr<Referee> referee;
+  if (!options.accuracy_csv.empty() && !raysets.empty()) {
+    const auto start = std::chrono::steady_clock::now();
+    referee = std::make_unique<Referee>(scene);
+    for (RaySet& rs : raysets) {
+      rs.truth.resize(rs.rays.size());
+      referee->judge(rs.rays, rs.truth);
+    }
+    progress(fmt::format("  referee: judged every ray exactly in {:.0f} ms",
+                         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()));
+  }
+  if (raysets.empty()) {
+    progress(fmt::format("[{}/{}] {}: no ray set applies, scene skipped", index + 1, count, scene.name));
+    return results;
+  }
+
+  struct Case {
+    std::string name;
+    ResultRow row;
+    std::optional<AccuracyRow> accuracy;
+    const Backend* backend;
+    const TraceExecutor* executor;
+    const RaySet* rayset;
+  };
+  std::vector<std::unique_ptr<TraceExecutor>> executors;
+  std::vector<std::unique_ptr<Backend>> backends;
+  std::vector<Case> cases;
+  for (int threads : settings.threads) {
+    executors.push_back(std::make_unique<TraceExecutor>(threads));
+    const TraceExecutor& executor = *executors.back();
+    // The reference's answers, per ray set, for agreement.
+    std::unique_ptr<Backend> reference = make_backend(kReferenceBackend, {threads});
+    executor.run([&] { reference->build(scene); });
+    std::vector<std::vector<Hit>> ref_hits(raysets.size());
+    std::vector<std::vector<std::uint8_t>> ref_occ(raysets.size());
+    for (std::size_t r = 0; r < raysets.size(); ++r) {
+      if (query_of(raysets[r].kind) == Query::kIntersect) {
+        ref_hits[r].resize(raysets[r].rays.size());
+        executor.intersect(*reference, raysets[r].rays, ref_hits[r]);
+      } else {
+        ref_occ[r].resize(raysets[r].rays.size());
+        executor.occluded(*reference, raysets[r].rays, ref_occ[r]);
+      }
+    }
+    reference.reset();
+
+    std::vector<Backend*> built;
+    for (const std::string& backend_name : settings.backends) {
+      backends.push_back(make_backend(backend_name, {threads}));
+      built.push_back(backends.back().get());
+    }
+    const std::vector<std::vector<double>> build_times =
+        time_builds_interleaved(built, scene, executor, settings.build_repetitions, settings.min_time);
+    for (std::size_t bi = 0; bi < built.size(); ++bi) {
+      const std::string& backend_name = settings.backends[bi];
+      const Backend* backend = built[bi];
+      const std::vector<double>& build_ms = build_times[bi];
+      progress(fmt::format("  built {} ({} threads) in {:.1f} ms, {:.1f} MiB", backend_name, threads, median(build_ms),
+                           backend->memory_bytes() / 1048576.0));
+      for (std::size_t r = 0; r < raysets.size(); ++r) {
+        const RaySet& rs = raysets[r];
+        ResultRow row;
+        row.scene = scene.name;
+        row.triangles = scene.triangles.size();
+        row.rayset = to_string(rs.kind);
+        row.query = to_string(query_of(rs.kind));
+        row.rays = rs.rays.size();
+        row.backend = backend_name;
+        row.threads = threads;
+        row.build_ms = median(build_ms);
+        row.build_ms_min = *std::min_element(build_ms.begin(), build_ms.end());
+        row.build_ms_max = *std::max_element(build_ms.begin(), build_ms.end());
+        row.memory_bytes = backend->memory_bytes();
+        row.sah_cost = backend->sah_cost();
+        Agreement a;
+        // Accuracy rows are single-run, single thread count: the first one.
+        std::optional<AccuracyRow> accuracy;
+        if (referee && threads == settings.threads.front()) {
+          accuracy.emplace();
+          accuracy->scene = scene.name;
+          if (entry) {
+            accuracy->scale = entry->scale;
+            accuracy->offset_x = entry->offset[0];
+            accuracy->offset_y = entry->offset[1];
+            accuracy->offset_z = entry->offset[2];
+          }
+          accuracy->rayset = row.rayset;
+          accuracy->query = row.query;
+          accuracy->backend = backend_name;
+          accuracy->accuracy_class = backend_accuracy_class(backend_name);
+        }
+        if (query_of(rs.kind) == Query::kIntersect) {
+          std::vector<Hit> hits(rs.rays.size());
+          executor.intersect(*backend, rs.rays, hits);
+          a = compare_hits(hits, ref_hits[r], rs.rays, scene.triangles);
+          if (accuracy) judge_hits(*referee, rs.rays, rs.truth, hits, rs.sources, *accuracy);
+        } else {
+          std::vector<std::uint8_t> occ(rs.rays.size());
+          executor.occluded(*backend, rs.rays, occ);
+          a = compare_occlusion(occ, ref_occ[r]);
+          if (accuracy) judge_occlusion(rs.rays, rs.truth, occ, *accuracy);
+        }
+        row.hit_rate = a.hit_rate();
+        row.agree_hit = a.agree_hit();
+        row.agree_prim = a.has_prims ? a.agree_prim() : std::nan("");
+        row.prim_ties = a.prim_ties;
+        row.t_relerr_max = a.has_prims ? a.t_relerr_max : std::nan("");
+        row.t_relerr_p999 = a.has_prims ? a.t_relerr_p999 : std::nan("");
+        row.disagreements = a.disagreements();
+        if (is_must_hit(rs.kind)) row.leaks = a.rays - a.hits;
+        const std::string name =
+            fmt::format("trace/{}/{}/{}/threads:{}", scene.name, row.rayset, backend_name, threads);
+        cases.push_back({name, row, accuracy, backend, &executor, &rs});
+      }
+    }
+  }
+
+  // Time every case of this scene in one Google Benchmark run, repetitions
+  // interleaved so that a noisy neighbour hits all backends alike.
+  benchmark::ClearRegisteredBenchmarks();
+  for (const Case& c : cases) {
+    const Case* cp = &c;
+    benchmark::RegisterBenchmark(c.name.c_str(),
+                                 [cp](benchmark::State& state) {
+                                   const std::vector<Ray>& rays = cp->rayset->rays;
+                                   std::vector<Hit> hits;
+                                   std::vector<std::uint8_t> occ;
+                                   const bool intersect = query_of(cp->rayset->kind) == Query::kIntersect;
+                                   if (intersect) hits.resize(rays.size());
+                                   else occ.resize(rays.size());
+                                   for (auto _ : state) {
+                                     if (intersect) cp->executor->intersect(*cp->backend, rays, hits);
+                                     else cp->executor->occluded(*cp->backend, rays, occ);
+                                     benchmark::DoNotOptimize(hits.data());
+                                     benchmark::DoNotOptimize(occ.data());
+                                     benchmark::ClobberMemory();
+                                   }
+                                   state.counters["rays"] = benchmark::Counter(static_cast<double>(rays.size()),
+                                                                               benchmark::Counter::kIsIterationInvariantRate);
+                                 })
+        ->Repetitions(settings.repetitions)
+        ->MinTime(settings.min_time)
+        ->MinWarmUpTime(settings.warmup)
+        ->UseRealTime()
+        ->Unit(benchmark::kMillisecond);
+  }
+  progress(fmt::format("[{}/{}] {}: timing {} cases x {} repetitions", index + 1, count, scene.name, cases.size(),
+                       settings.repetitions));
+  CollectingReporter reporter("rays", 1e-6, "Mrays/s", cases.size());
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::ClearRegisteredBenchmarks();
+  for (Case& c : cases) {
+    const std::vector<double>& s = reporter.samples(c.name);
+    c.row.mrays_s_samples = s;
+    c.row.reps = static_cast<int>(s.size());
+    c.row.mrays_s = median(s);
+    c.row.mrays_s_min = *std::min_element(s.begin(), s.end());
+    c.row.mrays_s_max = *std::max_element(s.begin(), s.end());
+  }
+  // Ratios to Embree measured in the same run: they survive a change of
+  // machine. The Embree row is in this scene, so they are final here.
+  for (Case& c : cases) {
+    for (const Case& ref : cases) {
+      if (ref.row.backend == kReferenceBackend && ref.row.rayset == c.row.rayset && ref.row.threads == c.row.threads &&
+          ref.row.mrays_s > 0)
+        c.row.ratio_to_embree = c.row.mrays_s / ref.row.mrays_s;
+    }
+    results.rows.push_back(c.row);
+    if (c.accuracy) {
+      c.accuracy->mrays_s = c.row.mrays_s;
+      c.accuracy->mrays_s_min = c.row.mrays_s_min;
+      c.accuracy->mrays_s_max = c.row.mrays_s_max;
+      results.accuracy.push_back(*c.accuracy);
+    }
+  }
+  return results;
+}
+
+std::string partial_results_note(const RunOptions& options, std::size_t finished, std::size_t total) {
+  return fmt::format("partial results ({} of {} scenes) in {}{}", finished, total, options.out_csv,
+                     options.accuracy_csv.empty() ? "" : " and " + options.accuracy_csv);
+}
+
+// Rewrites the results (and accuracy) CSV with every finished row, and their
+// metadata with status = "partial" and progress = "<k> of <n> scenes", or
+// status = "complete" when every scene is done. Signals wait until a CSV and
+// its metadata agree. Returns `finished`.
+std::size_t write_finished_scenes(const RunOptions& options, const Metadata& run_description,
+                                  const std::vector<ResultRow>& rows, const std::vector<AccuracyRow>& accuracy_rows,
+                                  std::size_t finished, std::size_t total) {
+  Metadata extra = run_description;
+  extra.emplace_back("status", finished == total ? "complete" : "partial");
+  extra.emplace_back("progress", fmt::format("{} of {} scenes", finished, total));
+  const Metadata metadata = collect_metadata(extra);
+  const SignalsDeferred deferred;
+  write_results_csv(options.out_csv, rows);
+  write_metadata(metadata_path_for(options.out_csv), metadata);
+  if (!options.accuracy_csv.empty()) {
+    write_accuracy_csv(options.accuracy_csv, accuracy_rows);
+    write_metadata(metadata_path_for(options.accuracy_csv), metadata);
+  }
+  set_interrupt_message(finished == total
+                            ? fmt::format("the run had finished; results in {}{}", options.out_csv,
+                                          options.accuracy_csv.empty() ? "" : " and " + options.accuracy_csv)
+                            : partial_results_note(options, finished, total));
+  if (finished < total) progress(partial_results_note(options, finished, total));
+  return finished;
+}
+
+}  // namespace
+
+std::vector<ResultRow> run_suite(const RunOptions& options) {
+  const SuiteSettings& settings = options.settings;
+  // Validate everything cheap before spending minutes.
+  for (const std::string& k : settings.raysets) parse_rayset_kind(k);
+  for (const std::string& b : settings.backends) make_backend(b);
+  if (settings.rays == 0) throw InputError("", "--rays must be at least 1");
+  if (settings.repetitions < 1) throw InputError("", "--reps must be at least 1");
+  check_writable(options.out_csv);
+  if (!options.accuracy_csv.empty()) check_writable(options.accuracy_csv);
+  std::vector<std::string> names = options.scenes;
+  if (names.empty()) {
+    for (const SuiteScene& s : options.suite.scenes) {
+      if (s.available()) names.push_back(s.name);
+      else if (!s.optional) throw InputError(options.suite.path, fmt::format("scene '{}': {} not found (add optional = true to skip it when absent)", s.name, s.path));
+      else progress(fmt::format("skipping scene '{}': {} not found", s.name, s.path));
+    }
+    if (names.empty()) throw InputError(options.suite.path, "no scene of the suite is available");
+  }
+
+  std::vector<LoadedScene> scenes;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    progress(fmt::format("[{}/{}] loading {}", i + 1, names.size(), names[i]));
+    scenes.push_back(load(options, names[i]));
+    const Scene& s = scenes.back().scene;
+    progress(fmt::format("  {} triangles{}", s.triangles.size(),
+                         s.skipped_points + s.skipped_lines
+                             ? fmt::format(" ({} points and {} lines skipped)", s.skipped_points, s.skipped_lines)
+                             : ""));
+  }
+
+  std::vector<std::string> scene_names;
+  for (const auto& s : scenes) scene_names.push_back(s.scene.name);
+  const Metadata run_description = {
+      {"command", options.command_line},
+      {"suite", options.suite.path},
+      {"scenes", fmt::format("{}", fmt::join(scene_names, ","))},
+      {"raysets", fmt::format("{}", fmt::join(settings.raysets, ","))},
+      {"backends", fmt::format("{}", fmt::join(settings.backends, ","))},
+      {"threads", fmt::format("{}", fmt::join(settings.threads, ","))},
+      {"rays", std::to_string(settings.rays)},
+      {"seed", std::to_string(settings.seed)},
+      {"repetitions", std::to_string(settings.repetitions)},
+      {"min_time_s", fmt::format("{}", settings.min_time)},
+      {"warmup_s", fmt::format("{}", settings.warmup)},
+      {"interleaved", options.interleave ? "true" : "false"},
+      {"reference_backend", kReferenceBackend},
+  };
+
+  initialize_google_benchmark(
+      {fmt::format("--benchmark_enable_random_interleaving={}", options.interleave ? "true" : "false")});
+  std::vector<ResultRow> rows;
+  std::vector<AccuracyRow> accuracy_rows;
+  std::size_t finished = 0;  // scenes whose rows are on disk
+  set_interrupt_message(fmt::format("no scene had finished; nothing written to {}", options.out_csv));
+  try {
+    for (std::size_t si = 0; si < scenes.size(); ++si) {
+      SceneResults scene = measure_scene(options, scenes[si], si, scenes.size());
+      rows.insert(rows.end(), scene.rows.begin(), scene.rows.end());
+      accuracy_rows.insert(accuracy_rows.end(), scene.accuracy.begin(), scene.accuracy.end());
+      finished = write_finished_scenes(options, run_description, rows, accuracy_rows, si + 1, scenes.size());
+    }
+  } catch (const std::exception& e) {
+    // What is on disk stays: the error says where, so that minutes of
+    // measurement are not lost to a failure in a later scene.
+    if (finished == 0) throw;
+    const std::string what = dynamic_cast<const std::bad_alloc*>(&e) ? "out of memory" : e.what();
+    throw std::runtime_error(fmt::format("{} (in scene {} of {}); {}", what, finished + 1, scenes.size(),
+                                         partial_results_note(options, finished, scenes.size())));
+  }
+  if (!options.accuracy_csv.empty())
+    progress(fmt::format("accuracy: {} ({} rows)", options.accuracy_csv, accuracy_rows.size()));
+  return rows;
+}
+
+std::string format_results_table(const std::vector<ResultRow>& rows) {
+  // Column widths follow the longest ray-set and backend names in the run.
+  std::size_t rayset_width = 6, backend_width = 7;
+  for (const ResultRow& r : rows) {
+    rayset_width = std::max(rayset_width, r.rayset.size());
+    backend_width = std::max(backend_width, r.backend.size());
+  }
+  const auto percent = [](double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.3f}%", 100.0 * v); };
+  std::string out, scene;
+  for (const ResultRow& r : rows) {
+    if (r.scene != scene) {
+      scene = r.scene;
+      out += fmt::format("\n{} ({} triangles)\n", r.scene, r.triangles);
+      out += fmt::format("  {:<{}} {:<{}} {:>3} {:>9} {:>19} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>7}\n", "rayset",
+                         rayset_width, "backend", backend_width, "thr", "Mrays/s", "[min - max]", "x embree", "hit", "agree",
+                         "same tri", "build ms", "MiB", "leaks");
+    }
+    out += fmt::format("  {:<{}} {:<{}} {:>3} {:>9.2f} {:>19} {:>8} {:>8} {:>9} {:>9} {:>9.1f} {:>9.1f} {:>7}\n", r.rayset,
+                       rayset_width, r.backend, backend_width, r.threads, r.mrays_s,
+                       fmt::format("[{:.2f} - {:.2f}]", r.mrays_s_min, r.mrays_s_max),
+                       r.ratio_to_embree > 0 ? fmt::format("{:.2f}", r.ratio_to_embree) : "-",
+                       fmt::format("{:.1f}%", 100.0 * r.hit_rate), percent(r.agree_hit), percent(r.agree_prim), r.build_ms,
+                       r.memory_bytes / 1048576.0, r.leaks ? std::to_string(*r.leaks) : "-");
+  }
+  return out;
+}
+
+}  // namespace raybench
