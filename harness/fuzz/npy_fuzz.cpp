@@ -1,13 +1,13 @@
-// Fuzz target: the .npy reader (harness/src/npy.h) on any bytes, read as a
+// Fuzz target: the .npy reader (harness/src/io/npy.h) on any bytes, read as a
 // ray file and as a float64 matrix. InputError is the reader's answer to bad
 // input; anything else (a crash, a sanitizer report, another exception, a
 // hang) is a finding.
 #include <cstddef>
 #include <cstdint>
 
-#include "error.h"
 #include "fuzz_file.h"
-#include "npy.h"
+#include "io/error.h"
+#include "io/npy.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static raybench::fuzz::FuzzFile file("input.npy");

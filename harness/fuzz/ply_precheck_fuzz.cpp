@@ -1,5 +1,5 @@
 // Fuzz target: the PLY header pre-check (ply_header_problem,
-// harness/src/ply_precheck.h), pure, on any bytes as a file's head (at most
+// harness/src/scene/ply_precheck.h), pure, on any bytes as a file's head (at most
 // the kPlyPrecheckBytes it is given). Any answer is fine; a crash, a
 // sanitizer report, an exception or a hang is a finding.
 #include <algorithm>
@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "ply_precheck.h"
+#include "scene/ply_precheck.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   raybench::ply_header_problem(

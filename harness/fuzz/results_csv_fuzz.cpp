@@ -1,4 +1,4 @@
-// Fuzz target: the CSV reader (read_csv_rows, harness/src/csv.h) on any
+// Fuzz target: the CSV reader (read_csv_rows, harness/src/io/csv.h) on any
 // bytes, as any CSV and as a results CSV (read_results_csv, which requires
 // the schema's columns). InputError is the reader's answer to bad input;
 // anything else (a crash, a sanitizer report, another exception, a hang) is
@@ -6,10 +6,10 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "csv.h"
-#include "error.h"
 #include "fuzz_file.h"
-#include "results_csv.h"
+#include "io/csv.h"
+#include "io/error.h"
+#include "results/results_csv.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static raybench::fuzz::FuzzFile file("results.csv");
