@@ -157,6 +157,24 @@ TEST(Npy, HugeDimensionsAreRefusedBeforeAllocatingWithAMessageThatSaysWhy) {
             std::string::npos);
 }
 
+// Found by harness/fuzz/npy_fuzz (issue 28), the exact input: a dimension
+// beyond 64 bits after a stray parenthesis escaped from std::stoull as
+// std::out_of_range and ended the process. Both readers refuse it as bad input.
+TEST(Npy, TheFuzzersOverlongDimensionIsBadInputNotACrash) {
+  TempDir dir;
+  const std::string input = std::string("\x93NUMPY\x01\x00\x76\x00", 10) +
+                            "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::string(31, ' ') +
+                            "(99999999999999999999, 8) \n" + std::string("\x00\x00\x40\x00\x00\x00\xf0\x3f", 8) +
+                            std::string(8, '\0');
+  ASSERT_EQ(input.size(), 135u);
+  const std::string path = dir.write("fuzzed.npy", input);
+  const std::string error = error_of(path);
+  EXPECT_NE(error.find(path), std::string::npos) << error;
+  EXPECT_NE(error.find("'shape'"), std::string::npos) << error;
+  std::size_t rows = 0, columns = 0;
+  EXPECT_NE(testing::input_error_of([&] { read_npy_f64(path, rows, columns); }).find("'shape'"), std::string::npos);
+}
+
 // Issue 28: a FIFO given as a ray file blocked forever in open().
 TEST(Npy, ARayFileThatIsNotARegularFileIsRefusedWithoutOpeningIt) {
   TempDir dir;
