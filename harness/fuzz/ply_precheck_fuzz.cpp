@@ -1,6 +1,6 @@
 // Fuzz target: the PLY header pre-check (ply_header_problem,
-// harness/src/scene/ply_precheck.h), pure, on any bytes as a file's head (at most
-// the kPlyPrecheckBytes it is given). Any answer is fine; a crash, a
+// harness/src/scene/ply_precheck.h), pure, on any bytes as a file's head (at
+// most the kPlyPrecheckBytes it is given). Any answer is fine; a crash, a
 // sanitizer report, an exception or a hang is a finding.
 #include <algorithm>
 #include <cstddef>
