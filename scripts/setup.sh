@@ -1,7 +1,8 @@
 # Shared by scripts/bench and scripts/test (sourced, not run): installs what
 # is missing from Debian, configures and builds Release. Works from any
 # working directory; the build lives in <repo>/build unless RAYBENCH_BUILD_DIR
-# says otherwise.
+# says otherwise. With RAYBENCH_SETUP_NO_BUILD=1 it only installs (scripts
+# that build elsewhere: scripts/fuzz, scripts/test-sanitized).
 set -eu
 
 RAYBENCH_ROOT=$(cd "$(dirname "$(readlink -f "$0")")/.." && pwd)
@@ -12,10 +13,16 @@ export RAYBENCH_ROOT RAYBENCH_BUILD_DIR
 RAYBENCH_PACKAGES="cmake ninja-build g++ git pkg-config libembree-dev libassimp-dev assimp-utils assimp-testmodels \
 libeigen3-dev libbenchmark-dev libgtest-dev libtbb-dev libcli11-dev libfmt-dev libtomlplusplus-dev libcgal-dev libgmp-dev libmpfr-dev \
 python3 python3-numpy python3-matplotlib"
+# What scripts/fuzz adds: clang and its libFuzzer and sanitizer runtimes
+# (Debian 12's clang is 14; the runtimes must be clang's own version).
+RAYBENCH_FUZZ_PACKAGES="clang-14 libclang-rt-14-dev"
 
+# raybench_install_packages [PACKAGES]: installs those of PACKAGES (default
+# RAYBENCH_PACKAGES) that are missing, or names them and stops.
 raybench_install_packages() {
   missing=""
-  for p in $RAYBENCH_PACKAGES; do
+  # shellcheck disable=SC2048  # package names never hold spaces
+  for p in ${*:-$RAYBENCH_PACKAGES}; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
   done
   [ -z "$missing" ] && return 0
@@ -46,4 +53,6 @@ raybench_build() {
 }
 
 raybench_install_packages
-raybench_build
+if [ "${RAYBENCH_SETUP_NO_BUILD:-0}" != 1 ]; then
+  raybench_build
+fi

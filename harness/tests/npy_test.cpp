@@ -53,6 +53,8 @@ TEST(Npy, HeaderIsAlignedTo64BytesAsNumpyWritesIt) {
   EXPECT_EQ(std::filesystem::file_size(dir.file("r.npy")), 128u + 2 * 32);
 }
 
+// 0 rows read as no rays; in the sanitizer build (.ci/run) also without
+// passing an empty vector's null data() to memcpy (issue 28).
 TEST(Npy, EmptyRayFileRoundTrips) {
   TempDir dir;
   write_ray_file(dir.file("r.npy"), {});
@@ -155,6 +157,24 @@ TEST(Npy, HugeDimensionsAreRefusedBeforeAllocatingWithAMessageThatSaysWhy) {
             std::string::npos);
 }
 
+// Found by harness/fuzz/npy_fuzz (issue 28), the exact input: a dimension
+// beyond 64 bits after a stray parenthesis escaped from std::stoull as
+// std::out_of_range and ended the process. Both readers refuse it as bad input.
+TEST(Npy, TheFuzzersOverlongDimensionIsBadInputNotACrash) {
+  TempDir dir;
+  const std::string input = std::string("\x93NUMPY\x01\x00\x76\x00", 10) +
+                            "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::string(31, ' ') +
+                            "(99999999999999999999, 8) \n" + std::string("\x00\x00\x40\x00\x00\x00\xf0\x3f", 8) +
+                            std::string(8, '\0');
+  ASSERT_EQ(input.size(), 135u);
+  const std::string path = dir.write("fuzzed.npy", input);
+  const std::string error = error_of(path);
+  EXPECT_NE(error.find(path), std::string::npos) << error;
+  EXPECT_NE(error.find("'shape'"), std::string::npos) << error;
+  std::size_t rows = 0, columns = 0;
+  EXPECT_NE(testing::input_error_of([&] { read_npy_f64(path, rows, columns); }).find("'shape'"), std::string::npos);
+}
+
 // Issue 28: a FIFO given as a ray file blocked forever in open().
 TEST(Npy, ARayFileThatIsNotARegularFileIsRefusedWithoutOpeningIt) {
   TempDir dir;
@@ -174,6 +194,15 @@ TEST(Npy, Float64MatricesRoundTrip) {
   std::size_t rows = 0, columns = 0;
   EXPECT_EQ(read_npy_f64(dir.file("h.npy"), rows, columns), data);
   EXPECT_EQ(rows, 2u);
+  EXPECT_EQ(columns, 4u);
+}
+
+TEST(Npy, EmptyFloat64MatrixRoundTrips) {
+  TempDir dir;
+  write_npy_f64(dir.file("h.npy"), {}, 0, 4);
+  std::size_t rows = 1, columns = 0;
+  EXPECT_TRUE(read_npy_f64(dir.file("h.npy"), rows, columns).empty());
+  EXPECT_EQ(rows, 0u);
   EXPECT_EQ(columns, 4u);
 }
 

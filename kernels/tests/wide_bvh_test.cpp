@@ -30,6 +30,14 @@ using testing::random_soup;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// Whether two arrays hold the same bytes. memcmp must not be given an empty
+// array's data(), null, even to compare 0 bytes (UBSan: null pointer passed
+// as argument), so empty arrays are compared by size alone.
+template <typename Array>
+bool same_bytes(const Array& a, const Array& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0);
+}
+
 class WideBvhBuild : public ::testing::TestWithParam<Bvh2Builder> {
  protected:
   // As the backends' quality builds (sbvh, reinsert) make them: BVH2 leaves
@@ -357,8 +365,8 @@ TEST_P(WideBvhBuild, TheTreeIsTheSameBuiltOnOneThreadOrTwo) {
     ASSERT_EQ(one.nodes.size(), two.nodes.size());
     ASSERT_EQ(one.packs.size(), two.packs.size());
     EXPECT_EQ(one.depth, two.depth);
-    EXPECT_EQ(0, std::memcmp(one.nodes.data(), two.nodes.data(), one.nodes.size() * sizeof(WideNode<W>)));
-    EXPECT_EQ(0, std::memcmp(one.packs.data(), two.packs.data(), one.packs.size() * sizeof(TrianglePack<W>)));
+    EXPECT_TRUE(same_bytes(one.nodes, two.nodes));
+    EXPECT_TRUE(same_bytes(one.packs, two.packs));
     EXPECT_TRUE(one.pack_prims == two.pack_prims);
   }
   });
@@ -381,14 +389,14 @@ TEST(WideBvhCollapse, ATreeSpanningSeveralHugePagesIsTheSameBuiltOnOneThreadOrTw
     const auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
     ASSERT_GT(bytes(one.packs) + bytes(one.edge_packs) + bytes(one.vertex_packs), kHugePageBytes);  // two or more
     ASSERT_EQ(one.nodes.size(), two.nodes.size());
-    EXPECT_EQ(0, std::memcmp(one.nodes.data(), two.nodes.data(), bytes(one.nodes)));
+    EXPECT_TRUE(same_bytes(one.nodes, two.nodes));
     EXPECT_TRUE(one.pack_prims == two.pack_prims);
     ASSERT_EQ(one.packs.size(), two.packs.size());
     ASSERT_EQ(one.edge_packs.size(), two.edge_packs.size());
     ASSERT_EQ(one.vertex_packs.size(), two.vertex_packs.size());
-    EXPECT_EQ(0, std::memcmp(one.packs.data(), two.packs.data(), bytes(one.packs)));
-    EXPECT_EQ(0, std::memcmp(one.edge_packs.data(), two.edge_packs.data(), bytes(one.edge_packs)));
-    EXPECT_EQ(0, std::memcmp(one.vertex_packs.data(), two.vertex_packs.data(), bytes(one.vertex_packs)));
+    EXPECT_TRUE(same_bytes(one.packs, two.packs));
+    EXPECT_TRUE(same_bytes(one.edge_packs, two.edge_packs));
+    EXPECT_TRUE(same_bytes(one.vertex_packs, two.vertex_packs));
     // Filled whole: every used lane holds its triangle, as its leaf form
     // stores it (a lane left as the fault's zero bytes would hold zeros).
     const auto expect_lane = [&](const auto& pack, const auto& expected, std::size_t p, int lane) {

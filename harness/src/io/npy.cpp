@@ -176,7 +176,7 @@ std::vector<Ray> read_ray_file(const std::string& path) {
   std::size_t rows = 0;
   const std::vector<char> body = read_matrix(path, "<f4", sizeof(float), 8, "float32 rays: ox oy oz tnear dx dy dz tfar", rows);
   std::vector<Ray> rays(rows);
-  std::memcpy(rays.data(), body.data(), body.size());
+  if (!body.empty()) std::memcpy(rays.data(), body.data(), body.size());  // never memcpy from an empty vector's null data()
   return rays;
 }
 
@@ -198,7 +198,7 @@ std::vector<double> read_npy_f64(const std::string& path, std::size_t& rows, std
     throw InputError(path, fmt::format("shape is {}: expected 1 to 1024 columns", shape_string(h.shape)));
   const std::vector<char> body = read_matrix(path, "<f8", sizeof(double), columns, "float64", rows);
   std::vector<double> out(rows * columns);
-  std::memcpy(out.data(), body.data(), body.size());
+  if (!body.empty()) std::memcpy(out.data(), body.data(), body.size());
   return out;
 }
 

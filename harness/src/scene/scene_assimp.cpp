@@ -198,6 +198,7 @@ class Answer {
     }
     const std::size_t room = scene_.triangles.size() * sizeof(Triangle) - received_;
     if (chunk.size() > room) throw InputError(path_, "assimp's reader process sent more than the mesh it announced");
+    if (chunk.empty()) return;  // a mesh of no triangles has no data() to copy to (null: memcpy's undefined behaviour)
     std::memcpy(reinterpret_cast<char*>(scene_.triangles.data()) + received_, chunk.data(), chunk.size());
     received_ += chunk.size();
   }
