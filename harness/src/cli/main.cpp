@@ -1,5 +1,6 @@
 // raybench: how fast is a ray-tracing kernel, and how often is it wrong, next
 // to Embree, on real meshes and the same rays. See README.md.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -144,7 +145,7 @@ std::string command_line(int argc, char** argv) {
 
 int run(int argc, char** argv) {
   CLI::App app{"raybench: throughput and per-ray agreement of ray-tracing kernels against Embree, on the same rays.\n"
-               "Exit status: 0 success, 2 bad usage or input."};
+               "Exit status: 0 success, 1 a regression (gate), 2 bad usage or input (one error line), 130/143 stopped by SIGINT/SIGTERM."};
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Show help for every command");
 
@@ -379,7 +380,10 @@ int run(int argc, char** argv) {
     return 0;
   }
   if (*backends_cmd) {
-    for (const BackendInfo& b : list_backends()) fmt::print("{:<20} {}\n", b.name, b.description);
+    const std::vector<BackendInfo> backends = list_backends();
+    std::size_t width = 0;  // names aligned in one column, however long the longest
+    for (const BackendInfo& b : backends) width = std::max(width, b.name.size());
+    for (const BackendInfo& b : backends) fmt::print("{:<{}}  {}\n", b.name, width, b.description);
     return 0;
   }
   if (*scenes_cmd && (scenes_bounds || !scenes_names.empty())) {

@@ -50,7 +50,7 @@ namespace raybench {
 struct SlabSeed {
   static constexpr std::string_view name = "slab_seed";
   static constexpr std::string_view description =
-      "seed 000 branchy slab test as written (|d| < 1e-6 is parallel, tmin from 0, NaN passes), float";
+      "the ray-AABB seed note's branchy slab test as written (|d| < 1e-6 is parallel, tmin from 0, NaN passes), float";
   static constexpr AccuracyClass accuracy = AccuracyClass::kEpsilon;
 
   // The note's parallel threshold, `abs(dir.x) < 0.000001f`: an

@@ -52,7 +52,7 @@ namespace raybench {
 struct Obb {
   static constexpr std::string_view name = "obb";
   static constexpr std::string_view description =
-      "ray-OBB: ray into the box frame (Eigen, double), epsilon-free closed slab test (seed 004 fixed)";
+      "ray-OBB: ray into the box frame (Eigen, double), epsilon-free closed slab test (the ray-OBB seed note's test, fixed)";
   static constexpr AccuracyClass accuracy = AccuracyClass::kFast;
 
   static bool intersect(const Ray& ray, float tmax, const OrientedBox& box, BoxHit& out) {

@@ -45,7 +45,7 @@ namespace raybench {
 struct ObbSeed {
   static constexpr std::string_view name = "obb_seed";
   static constexpr std::string_view description =
-      "seed 004 ray-OBB slab test as written (minT = DBL_MIN, |f| > 1e-20 parallel test)";
+      "the ray-OBB seed note's slab test as written (minT = DBL_MIN, |f| > 1e-20 parallel test)";
   static constexpr AccuracyClass accuracy = AccuracyClass::kEpsilon;
 
   // The note's parallel threshold on f = n.d: absolute, so it

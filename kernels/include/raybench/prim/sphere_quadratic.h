@@ -29,7 +29,7 @@ namespace raybench {
 struct SphereQuadratic {
   static constexpr std::string_view name = "sphere_quadratic";
   static constexpr std::string_view description =
-      "textbook quadratic b^2-4ac ray-sphere test (seed 003, chai3d), float";
+      "textbook quadratic b^2-4ac ray-sphere test (the form the ray-sphere seed note cites, chai3d), float";
   static constexpr AccuracyClass accuracy = AccuracyClass::kFast;
 
   // True when a root lies in (ray.tnear, tmax]; out gets both roots. Every

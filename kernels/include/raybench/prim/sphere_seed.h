@@ -41,7 +41,7 @@ namespace raybench {
 struct SphereSeed {
   static constexpr std::string_view name = "sphere_seed";
   static constexpr std::string_view description =
-      "seed 003 geometric ray-sphere test as written (projoc < 0 rejects, FLT_EPSILON tangent test), float";
+      "the ray-sphere seed note's geometric test as written (projoc < 0 rejects, FLT_EPSILON tangent test), float";
   static constexpr AccuracyClass accuracy = AccuracyClass::kEpsilon;
 
   // The note's FLOAT_EPSILON: FLT_EPSILON = 2^-23, the spacing of floats at 1,

@@ -23,7 +23,7 @@ namespace raybench {
 
 struct MollerTrumbore {
   static constexpr std::string_view name = "mt";
-  static constexpr std::string_view description = "Moller-Trumbore (seed 002) without absolute epsilons, float";
+  static constexpr std::string_view description = "Moller-Trumbore (the seed note's algorithm) without absolute epsilons, float";
   static constexpr AccuracyClass accuracy = AccuracyClass::kFast;
 
   // The per-triangle data the BVH stores in leaf order: edges precomputed.

@@ -23,7 +23,7 @@ namespace raybench {
 
 struct MollerTrumboreSeed {
   static constexpr std::string_view name = "mt_seed";
-  static constexpr std::string_view description = "Moller-Trumbore as seed 002 writes it: det < 1e-4 rejection, no t >= 0 test";
+  static constexpr std::string_view description = "Moller-Trumbore as the seed note writes it: det < 1e-4 rejection, no t >= 0 test";
   static constexpr AccuracyClass accuracy = AccuracyClass::kEpsilon;
 
   using Prepared = Triangle;  // the note computes the edges per call
