@@ -30,7 +30,6 @@
 #include "scene/scene.h"
 #include "suite/results_table.h"
 #include "suite/scene_selection.h"
-#include "suite/settings_rules.h"
 #include "measure/trace.h"
 
 namespace raybench {
@@ -51,12 +50,13 @@ struct RaySet {
 };
 
 // Rays are stored under a name that carries everything they depend on, so a
-// later run (or a later commit) traces exactly the same rays.
+// later run (or a later commit) traces exactly the same rays. The scene's name
+// is a safe file name: manifests (load_suite) and --scene (choose_scene) check
+// every name with scene_name_problem before a run starts.
 // With `sources`, the rays are made again (bit-identical) to learn where
 // each secondary ray starts; they are not stored in the ray file.
 std::vector<Ray> obtain_rays(const RayGenerator& generator, const Scene& scene, const RaySetSpec& spec,
                              const std::string& rays_dir, std::vector<std::int32_t>* sources = nullptr) {
-  if (const std::string problem = scene_name_problem(scene.name); !problem.empty()) throw InputError(printable(scene.name), problem);
   const std::string path = fmt::format("{}/{}.{}.n{}.{:016x}.npy", rays_dir, scene.name, to_string(spec.kind),
                                        spec.count, generator.key(spec));
   std::error_code ec;
