@@ -4,6 +4,18 @@
 // single-primitive kernels (prim/aabb_*.h, prim/obb_*.h, prim/sphere_*.h) in
 // `raybench accuracy-kernels`; referee/exact_triangle.h is the triangle one.
 //
+// The semantics they decide and the accuracy of t: above ExactPrimitiveHit.
+#pragma once
+
+#include <limits>
+
+#include "raybench/math/bbox.h"
+#include "raybench/math/ray.h"
+#include "raybench/prim/obb.h"
+#include "raybench/prim/sphere.h"
+
+namespace raybench {
+
 // Semantics (../shared/EXTREMES.md, "Decide the semantics"):
 // - The ray: o + t d for t in (lo, tfar], lo = max(tnear, 0): open at lo,
 //   closed at tfar (math/ray.h). tnear and tfar may be infinite; an empty
@@ -60,17 +72,6 @@
 // extent throws std::invalid_argument, except the empty box (lower > upper on
 // some axis, as BBox starts), which nothing hits. A negative half extent is
 // an empty OBB; a negative radius is the sphere of radius |r| (only r^2 is used).
-#pragma once
-
-#include <limits>
-
-#include "raybench/math/bbox.h"
-#include "raybench/math/ray.h"
-#include "raybench/prim/obb.h"
-#include "raybench/prim/sphere.h"
-
-namespace raybench {
-
 struct ExactPrimitiveHit {
   bool hit = false;
   // Hits: the double nearest the exact t (see the accuracy note above); NaN on a miss.

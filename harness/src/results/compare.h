@@ -10,8 +10,33 @@
 // divided by that run's Embree median; it survives a change of machine or a
 // noisy neighbour, so it is what CI gates. Agreement and accuracy columns are
 // deterministic for the same rays and code: any change is reported as it is,
-// without statistics.
-//
+// without statistics. What compare and gate refuse as unreadable: the rule
+// above read_results_file.
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace raybench {
+
+// A results file that `raybench run` wrote before its last scene was done
+// (metadata status = "partial"): it holds the rows of the finished scenes.
+struct PartialFile {
+  std::string path;
+  std::string progress;  // the metadata's `progress`, e.g. "2 of 5 scenes"; "" if absent
+};
+
+struct ResultsFile {
+  std::string path;
+  std::vector<std::map<std::string, std::string>> rows;
+  std::vector<std::size_t> lines;               // each row's line in the file, for messages
+  std::map<std::string, std::string> metadata;  // from the .meta.toml beside it; empty if absent
+  std::vector<PartialFile> partial;             // this file if partial; pooled: every partial run
+};
+
 // What compare and gate refuse. Neither ever passes on a value it cannot read
 // as a number. The rule: what makes a file unreadable as results is bad input
 // (InputError, exit 2, naming the file, the row's line and key, and the
@@ -40,30 +65,6 @@
 //   Partial files (a run still going or interrupted: metadata status =
 //   "partial") are read; compare and gate print a note naming the file and
 //   its progress.
-#pragma once
-
-#include <cstddef>
-#include <map>
-#include <optional>
-#include <string>
-#include <vector>
-
-namespace raybench {
-
-// A results file that `raybench run` wrote before its last scene was done
-// (metadata status = "partial"): it holds the rows of the finished scenes.
-struct PartialFile {
-  std::string path;
-  std::string progress;  // the metadata's `progress`, e.g. "2 of 5 scenes"; "" if absent
-};
-
-struct ResultsFile {
-  std::string path;
-  std::vector<std::map<std::string, std::string>> rows;
-  std::vector<std::size_t> lines;               // each row's line in the file, for messages
-  std::map<std::string, std::string> metadata;  // from the .meta.toml beside it; empty if absent
-  std::vector<PartialFile> partial;             // this file if partial; pooled: every partial run
-};
 
 // Reads a results CSV and its metadata, and checks every row (see the rules
 // above); throws InputError naming the file, and the row and column.

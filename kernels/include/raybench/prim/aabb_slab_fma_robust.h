@@ -10,6 +10,23 @@
 // than the subtraction per plane they save
 // (measured: docs/notes/kernels-box-tests.md).
 //
+// Why it is conservative, and its error bound: above struct SlabFmaRobust.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string_view>
+
+#include "raybench/math/bbox.h"
+#include "raybench/math/inline.h"
+#include "raybench/prim/aabb.h"
+#include "raybench/prim/aabb_slab.h"
+#include "raybench/prim/aabb_slab_fma.h"
+#include "raybench/prim/aabb_slab_robust.h"
+
+namespace raybench {
+
 // Why SlabFma is not conservative: its distance plane * r - p, r = fl(1/d),
 // carries the rounding of p = fl(o * r), an error absolute in t (u |o / d|,
 // u = 2^-24), and the rounding of r, relative to the distance. Both are
@@ -45,22 +62,6 @@
 //
 // As a standalone test (intersect, the microbenchmarks) the box is its own
 // extent, and the offsets are computed per box.
-#pragma once
-
-#include <algorithm>
-#include <cmath>
-#include <limits>
-#include <string_view>
-
-#include "raybench/math/bbox.h"
-#include "raybench/math/inline.h"
-#include "raybench/prim/aabb.h"
-#include "raybench/prim/aabb_slab.h"
-#include "raybench/prim/aabb_slab_fma.h"
-#include "raybench/prim/aabb_slab_robust.h"
-
-namespace raybench {
-
 struct SlabFmaRobust {
   static constexpr std::string_view name = "slab_fma_robust";
   static constexpr std::string_view description =
