@@ -67,13 +67,25 @@ TEST(ResultsCsv, RowsRoundTripAndNotApplicableIsEmpty) {
   EXPECT_EQ(rows[0].at("disagreements"), "4");
 }
 
-TEST(ResultsCsv, SahCostIsTheLastColumnAndRoundTrips) {
+TEST(ResultsCsv, ColumnsAreAppendedAfterThoseOfOlderFiles) {
   // Appended last, so the columns of older files keep their positions.
-  EXPECT_EQ(result_columns().back(), "sah_cost");
+  const std::vector<std::string>& c = result_columns();
+  ASSERT_GE(c.size(), 29u);
+  EXPECT_EQ(c[24], "leaks");
+  EXPECT_EQ(c[25], "sah_cost");
+  EXPECT_EQ(c[26], "reference");
+  EXPECT_EQ(c[27], "ratio_to_reference");
+  EXPECT_EQ(c[28], "plugin");
+}
+
+TEST(ResultsCsv, SahCostReferenceAndPluginRoundTrip) {
   TempDir dir;
   ResultRow ours;
   ours.backend = "bvh8:sweep";
   ours.sah_cost = 41.8125;
+  ours.reference = "embree";
+  ours.ratio_to_reference = 1.5;
+  ours.plugin = "my_bvh";
   ResultRow embree;
   embree.backend = "embree";  // sah_cost left NaN: not applicable
   write_results_csv(dir.file("r.csv"), {ours, embree});
@@ -81,6 +93,11 @@ TEST(ResultsCsv, SahCostIsTheLastColumnAndRoundTrips) {
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[0].at("sah_cost"), "41.8125");
   EXPECT_EQ(rows[1].at("sah_cost"), "");
+  EXPECT_EQ(rows[0].at("reference"), "embree");
+  EXPECT_EQ(rows[0].at("ratio_to_reference"), "1.5");
+  EXPECT_EQ(rows[0].at("plugin"), "my_bvh");
+  EXPECT_EQ(rows[1].at("ratio_to_reference"), "");  // 0: no reference measured
+  EXPECT_EQ(rows[1].at("plugin"), "");
 }
 
 TEST(ResultsCsv, AFileFromBeforeTheSahCostColumnStillReads) {

@@ -8,6 +8,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "raybench/math/ray.h"
@@ -29,12 +30,23 @@ struct BackendConfig {
   int threads = 1;  // threads a backend may use to build
 };
 
+std::string backend_accuracy_class(const std::string& name);
+
 class Backend {
  public:
   virtual ~Backend() = default;
   // The full name it was made from, options included (e.g. "embree:high").
   virtual const std::string& name() const = 0;
   virtual Capabilities capabilities() const { return {}; }
+  // The accuracy class of its triangle test: what the registry lists for its
+  // name (backend_accuracy_class), or what a plugin reports for itself.
+  virtual std::string accuracy_class() const { return backend_accuracy_class(name()); }
+  // The name a plugin reports for itself (the results' `plugin` column);
+  // empty for built-in backends.
+  virtual std::string plugin_name() const { return {}; }
+  // What its results depend on beyond its name, as metadata key/value pairs
+  // (a plugin: its file's absolute path and content hash, its description).
+  virtual std::vector<std::pair<std::string, std::string>> provenance() const { return {}; }
   // Builds the acceleration structure; timed by the caller apart from tracing.
   virtual void build(const Scene& scene) = 0;
   // Bytes of the acceleration structure, triangle data it copied included.

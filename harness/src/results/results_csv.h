@@ -33,6 +33,14 @@ struct ResultRow {
   std::optional<std::size_t> leaks;
   // SAH cost of the backend's tree (Backend::sah_cost); NaN when not applicable.
   double sah_cost = std::numeric_limits<double>::quiet_NaN();
+  // The run's timing reference (--reference, default embree) and this row's
+  // speed relative to it: the median over the interleaved rounds of
+  // (this row's sample / the reference's sample of the same round); 0 if none.
+  std::string reference;
+  double ratio_to_reference = 0;
+  // Plugins (--backend plugin:PATH.so): the name the plugin reports; empty
+  // for built-in backends.
+  std::string plugin;
 };
 
 // Column names in file order. Columns are only ever appended, so a reader

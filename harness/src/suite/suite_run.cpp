@@ -198,6 +198,7 @@ SceneResults measure_scene(const RunOptions& options, const LoadedScene& loaded,
         row.build_ms_max = *std::max_element(build_ms.begin(), build_ms.end());
         row.memory_bytes = backend->memory_bytes();
         row.sah_cost = backend->sah_cost();
+        row.plugin = backend->plugin_name();
         Agreement a;
         // Accuracy rows are single-run, single thread count: the first one.
         std::optional<AccuracyRow> accuracy;
@@ -213,7 +214,7 @@ SceneResults measure_scene(const RunOptions& options, const LoadedScene& loaded,
           accuracy->rayset = row.rayset;
           accuracy->query = row.query;
           accuracy->backend = backend_name;
-          accuracy->accuracy_class = backend_accuracy_class(backend_name);
+          accuracy->accuracy_class = backend->accuracy_class();
         }
         if (query_of(rs.kind) == Query::kIntersect) {
           std::vector<Hit> hits(rs.rays.size());
