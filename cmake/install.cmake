@@ -3,7 +3,8 @@
 #   P/include/raybench/plugin.h
 #   P/share/raybench/suites/procedural.toml, P/share/raybench/gate.toml
 #   P/lib/cmake/raybench/  raybenchConfig.cmake, raybenchConfigVersion.cmake,
-#                          raybenchTargets.cmake, raybench_add_plugin.cmake
+#                          raybenchTargets.cmake, raybench_add_plugin.cmake,
+#                          raybench_plugin.map
 # The installed binary finds its share folder relative to itself
 # (harness/src/io/default_paths.h) and the package names no path of this
 # build: P can be moved. Tests and test-only targets are not installed.
@@ -38,4 +39,5 @@ install(FILES
   ${PROJECT_BINARY_DIR}/package/raybenchConfig.cmake
   ${PROJECT_BINARY_DIR}/package/raybenchConfigVersion.cmake
   ${PROJECT_SOURCE_DIR}/plugin/cmake/raybench_add_plugin.cmake
+  ${PROJECT_SOURCE_DIR}/plugin/cmake/raybench_plugin.map
   DESTINATION ${RAYBENCH_INSTALL_CMAKEDIR})

@@ -6,8 +6,9 @@
 # sources alike (enable the languages in your project()). What it sets:
 # - links raybench::plugin (the header; nothing else of raybench);
 # - hidden visibility for everything (-fvisibility=hidden, inline functions
-#   too, symbols of static libraries linked in: --exclude-libs), so the only
-#   exported symbol is the entry point you mark RAYBENCH_PLUGIN_EXPORT;
+#   too, symbols of static libraries linked in: --exclude-libs, and a linker
+#   version script: raybench_plugin.map), so the only exported symbol is the
+#   entry point raybench_plugin (mark it RAYBENCH_PLUGIN_EXPORT);
 # - -O3 in every configuration but Debug (also with no CMAKE_BUILD_TYPE),
 #   never -ffast-math (it deletes NaN/Inf handling; add it yourself if you
 #   must);
@@ -21,6 +22,7 @@
 # definitions to it as usual.
 function(raybench_add_plugin name)
   cmake_parse_arguments(PARSE_ARGV 1 arg "NATIVE" "OUTPUT_DIRECTORY" "")
+  set(_raybench_plugin_map ${CMAKE_CURRENT_FUNCTION_LIST_DIR}/raybench_plugin.map)
   if(NOT arg_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "raybench_add_plugin(${name}): no source files")
   endif()
@@ -41,6 +43,8 @@ function(raybench_add_plugin name)
     target_compile_options(${name} PRIVATE "$<${gnu_like}:-march=native>")
   endif()
   if(CMAKE_SYSTEM_NAME STREQUAL "Linux")
-    target_link_options(${name} PRIVATE "LINKER:-z,defs" "LINKER:--exclude-libs,ALL")
+    target_link_options(${name} PRIVATE "LINKER:-z,defs" "LINKER:--exclude-libs,ALL"
+      "LINKER:--version-script=${_raybench_plugin_map}")
+    set_property(TARGET ${name} APPEND PROPERTY LINK_DEPENDS ${_raybench_plugin_map})
   endif()
 endfunction()
