@@ -36,8 +36,11 @@ std::string env_or_empty(const char* name) {
 DefaultPaths default_paths_for(const DefaultPathsInputs& in) {
   DefaultPaths d;
   std::error_code ec;
-  d.build_tree = !in.executable.empty() && !in.binary_dir.empty() && is_inside(in.executable, in.binary_dir) &&
-                 fs::exists(fs::path(in.source_dir) / "CMakeLists.txt", ec);
+  const fs::path exe_dir = in.executable.empty() ? fs::path(".") : fs::path(in.executable).parent_path();
+  const std::string share = (exe_dir.parent_path() / "share" / "raybench").lexically_normal().string();
+  const bool beside_share = fs::is_directory(share, ec);  // installed, even into a folder of the build tree
+  d.build_tree = !beside_share && !in.executable.empty() && !in.binary_dir.empty() &&
+                 is_inside(in.executable, in.binary_dir) && fs::exists(fs::path(in.source_dir) / "CMakeLists.txt", ec);
   if (d.build_tree) {
     const std::string src = in.source_dir;
     d.suite = src + "/meshes/default.toml";
@@ -50,8 +53,6 @@ DefaultPaths default_paths_for(const DefaultPathsInputs& in) {
     return d;
   }
   // Installed: P/bin/raybench reads P/share/raybench.
-  const fs::path exe_dir = in.executable.empty() ? fs::path(".") : fs::path(in.executable).parent_path();
-  const std::string share = (exe_dir.parent_path() / "share" / "raybench").lexically_normal().string();
   d.suite = share + "/suites/procedural.toml";
   d.gate_config = share + "/gate.toml";
   d.out_csv = "raybench-results.csv";

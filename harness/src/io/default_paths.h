@@ -32,8 +32,10 @@ struct DefaultPathsInputs {
   std::string home;            // $HOME ("" when unset)
 };
 
-// Build tree: `executable` lies inside `binary_dir` and `source_dir` still
-// holds a CMakeLists.txt. Otherwise installed: suite and gate config from
+// Build tree: `executable` lies inside `binary_dir`, `source_dir` still holds
+// a CMakeLists.txt, and there is no <executable's folder>/../share/raybench
+// (an install into a folder of the build tree is still an install).
+// Otherwise installed: suite and gate config from
 // <executable's folder>/../share/raybench (suites/procedural.toml, gate.toml),
 // out ./raybench-results.csv (kernels: ./raybench-kernels.csv and .json,
 // accuracy-kernels: ./raybench-accuracy-kernels.csv), rays in
