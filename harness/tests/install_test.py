@@ -166,6 +166,9 @@ class CiRecipeTest(unittest.TestCase):
     baseline as the reference, then `raybench gate --current --candidate` with its JSON verdicts."""
 
     def recipe(self, candidate_dir, *definitions):
+        # 3 rounds: too few for the signed-rank test to ever call a speed change, so the verdicts
+        # are deterministic (accuracy only) however busy the machine is; the README's recipe and
+        # the workflow use 9.
         cwd = tempfile.mkdtemp(dir=INSTALLED.root, prefix="ci-")
         base = "plugin:" + INSTALLED.plugin
         cand = "plugin:" + INSTALLED.build_plugin(candidate_dir, *definitions)
