@@ -162,23 +162,23 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
     executors.push_back(std::make_unique<TraceExecutor>(threads));
     const TraceExecutor& executor = *executors.back();
     // Embree's answers, per ray set, for agreement.
-    std::unique_ptr<Backend> reference = make_backend(kAgreementBackend, {threads});
-    executor.run([&] { reference->build(scene); });
+    std::unique_ptr<Backend> baseline = make_backend(kAgreementBackend, {threads});
+    executor.run([&] { baseline->build(scene); });
     std::vector<std::vector<Hit>> ref_hits(raysets.size());
     std::vector<std::vector<std::uint8_t>> ref_occ(raysets.size());
     for (std::size_t r = 0; r < raysets.size(); ++r) {
       const ScreenedRays& screened = raysets[r].screened;
       if (query_of(raysets[r].kind) == Query::kIntersect) {
         ref_hits[r].resize(screened.rays.size());
-        executor.intersect(*reference, screened.rays, ref_hits[r]);
+        executor.intersect(*baseline, screened.rays, ref_hits[r]);
         force_misses(screened, ref_hits[r]);
       } else {
         ref_occ[r].resize(screened.rays.size());
-        executor.occluded(*reference, screened.rays, ref_occ[r]);
+        executor.occluded(*baseline, screened.rays, ref_occ[r]);
         force_misses(screened, ref_occ[r]);
       }
     }
-    reference.reset();
+    baseline.reset();
     // What the camera sees, once per scene: Embree's primary hits.
     for (std::size_t r = 0; r < raysets.size() && !results.camera; ++r) {
       if (raysets[r].kind != RaySetKind::kPrimary || ref_hits[r].empty()) continue;
