@@ -92,6 +92,12 @@ TEST(RunRounds, WithoutShufflingEveryRoundRunsTheCasesInTheirOrder) {
   for (const auto& s : samples) EXPECT_EQ(s.size(), 2u);
 }
 
+TEST(RunRounds, NoCasesIsNoSamples) {
+  int rounds = 0;
+  EXPECT_TRUE(run_rounds({}, quick(3, true), [&](int, double) { ++rounds; }).empty());
+  EXPECT_EQ(rounds, 0);
+}
+
 TEST(RunRounds, ACaseThatFailsIsAnErrorNamingIt) {
   std::vector<RoundCase> cases{{"fails", [](benchmark::State& state) {
                                   for (auto _ : state) {
