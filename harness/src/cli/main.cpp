@@ -26,6 +26,7 @@
 #include "io/npy.h"
 #include "scene/procedural.h"
 #include "rays/rayset.h"
+#include "rays/screening.h"
 #include "scene/scene.h"
 #include "suite/scene_selection.h"
 #include "suite/settings_rules.h"
@@ -153,7 +154,7 @@ int run(int argc, char** argv) {
   RunOptions run_options;
   std::string suite_path = kDefaultSuite;
   std::vector<std::string> run_raysets, run_backends, run_threads;
-  std::string run_rays, run_reps, run_build_reps, run_seed, run_min_time, run_warmup;
+  std::string run_rays, run_reps, run_build_reps, run_seed, run_min_time, run_warmup, run_reference;
   bool no_interleave = false, list_only = false;
   run_options.out_csv = kDefaultOut;
   run_options.rays_dir = kDefaultRaysDir;
@@ -169,14 +170,18 @@ int run(int argc, char** argv) {
   run_cmd->add_option("--backend,-b", run_backends, "Backends, e.g. embree,embree:high,bvh2 (see 'raybench backends'); 'bvh2:*' is bvh2 with every triangle test")
       ->delimiter(',');
   run_cmd->add_option("--threads,-t", run_threads, "Thread counts, e.g. 1,2 (default: 1)")->delimiter(',')->type_name("INT");
-  run_cmd->add_option("--reps", run_reps, "Timed repetitions per case; the median is reported (default: 5)")->type_name("INT");
+  run_cmd->add_option("--reps", run_reps, "Timed rounds: each round traces every case of a scene once, in a shuffled order; the median is reported (default: 5)")->type_name("INT");
+  run_cmd->add_option("--reference", run_reference,
+                      "Backend of the run that ratio_to_reference and the table's 'x NAME' are relative to, paired round by "
+                      "round, e.g. plugin:old.so (default: embree when the run has it)")
+      ->type_name("NAME");
   run_cmd->add_option("--build-reps", run_build_reps, "Timed rounds of builds per backend, interleaved across backends after one untimed build each; a build shorter than --min-time is repeated within its round (default: 3)")->type_name("INT");
   run_cmd->add_option("--seed", run_seed, "Ray generation seed (default: 1)")->type_name("INT");
   run_cmd->add_option("--min-time", run_min_time, "Minimum seconds per repetition, of a trace or of a round of builds (default: 0.05)")->type_name("SECONDS");
-  run_cmd->add_option("--warmup", run_warmup, "Untimed warm-up seconds per case (default: 0.05)")->type_name("SECONDS");
+  run_cmd->add_option("--warmup", run_warmup, "Untimed warm-up seconds per case, before its first round (default: 0.05)")->type_name("SECONDS");
   run_cmd->add_option("--out,-o", run_options.out_csv, "Results CSV; metadata goes beside it as .meta.toml")->capture_default_str();
   run_cmd->add_option("--rays-dir", run_options.rays_dir, "Where ray sets are stored and reused")->capture_default_str();
-  run_cmd->add_flag("--no-interleave", no_interleave, "Run each case's repetitions back to back instead of interleaved");
+  run_cmd->add_flag("--no-interleave", no_interleave, "Run every round's cases in the same order (backends as listed) instead of a shuffled one");
   run_cmd->add_flag("--list", list_only, "List the suite's scenes and whether they are available, then exit");
   run_cmd->add_option("--accuracy", run_options.accuracy_csv,
                       "Also judge every ray with the exact referee and write the accuracy CSV here "
@@ -432,6 +437,11 @@ int run(int argc, char** argv) {
     override_with("--seed", run_seed, seed_setting, &SuiteSettings::seed);
     override_with("--min-time", run_min_time, min_time_setting, &SuiteSettings::min_time);
     override_with("--warmup", run_warmup, warmup_setting, &SuiteSettings::warmup);
+    if (run_cmd->count("--reference"))
+      overrides.push_back([v = flag_value("--reference", run_reference, reference_setting)](SuiteSettings& s) {
+        s.reference = v;
+        s.reference_given = "--reference";
+      });
     check_named("--out", run_options.out_csv);
     if (run_options.rays_dir.empty()) throw InputError("--rays-dir", "must name a folder, got ''");
     check_outputs({output("--out", run_options.out_csv), metadata_of("--out", run_options.out_csv),
@@ -484,7 +494,9 @@ int run(int argc, char** argv) {
     Suite storage;
     const Suite* suite = suite_if_readable(trace_suite, trace_cmd->count("--suite") > 0, storage);
     std::unique_ptr<Backend> backend = make_backend(trace_backend, {threads});
-    const std::vector<Ray> rays = read_ray_file(trace_rays);
+    // What every backend traces (rays/screening.h); untraceable rays answer misses.
+    const ScreenedRays screened = screen_rays(read_ray_file(trace_rays));
+    const std::vector<Ray>& rays = screened.rays;
     const SceneArg s = resolve_scene(trace_scene, suite);
     const TraceExecutor executor(threads);
     executor.run([&] { backend->build(s.scene); });
@@ -492,6 +504,7 @@ int run(int argc, char** argv) {
     if (trace_occluded) {
       std::vector<std::uint8_t> occ(rays.size());
       executor.occluded(*backend, rays, occ);
+      force_misses(screened, occ);
       std::vector<double> out(occ.begin(), occ.end());
       for (std::uint8_t o : occ) hits += o;
       write_npy_f64(trace_out, out, rays.size(), 1);
@@ -500,6 +513,7 @@ int run(int argc, char** argv) {
     } else {
       std::vector<Hit> h(rays.size());
       executor.intersect(*backend, rays, h);
+      force_misses(screened, h);
       std::vector<double> out(rays.size() * 4);
       for (std::size_t i = 0; i < h.size(); ++i) {
         out[4 * i + 0] = h[i].t;
