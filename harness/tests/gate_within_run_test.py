@@ -116,6 +116,10 @@ class Speed(WithinRunTestCase):
         self.assertAlmostEqual(f["p_value"], 1 / 512, places=9)  # every round slower: 2^-9
         self.assertEqual(f["limit"], 0.1)
         self.assertEqual(len(verdicts["failures"]), 2)  # both scenes
+        # --verbose: every candidate row's paired ratio, its range and p.
+        verbose = self.gate(self.path("run.csv"), "--verbose")
+        self.assertEqual(verbose.stdout.split()[:7], ["scene", "rayset", "backend", "thr", "rounds", "x", BASE])
+        self.assertEqual(verbose.stdout.splitlines()[1].split()[-5:], ["0.700", "[0.680", "-", "0.730]", "0.002"])
 
     def test_a_same_speed_noisy_candidate_passes(self):
         # Within 4 % of the reference either way, round by round, while the machine swings by 40 %.
@@ -147,6 +151,11 @@ class Speed(WithinRunTestCase):
         # The same with 7 rounds fails.
         rows = run_rows([0.5] * 7, reference_samples=BUSY[:7])
         self.assertEqual(self.gate(self.write_run("seven", rows)).returncode, 1)
+        # alpha = 0.05 needs 5 (2^-5 = 0.031): the 6 rounds fail.
+        config = self.path("gate.toml")
+        with open(config, "w") as f:
+            f.write("alpha = 0.05\n")
+        self.assertEqual(self.gate(self.path("run.csv"), "--config", config).returncode, 1)
 
 
 class Accuracy(WithinRunTestCase):

@@ -287,7 +287,7 @@ int run(int argc, char** argv) {
                        "exceed the reference's fails");
   gate_cmd->add_option("--json", gate_json, "Also write the verdicts as JSON to this file (docs/gating.md)");
   gate_cmd->add_option("--config", gate_config, "Thresholds (TOML)")->capture_default_str();
-  gate_cmd->add_flag("--verbose,-v", gate_verbose, "Also print the full comparison table (with --baseline)");
+  gate_cmd->add_flag("--verbose,-v", gate_verbose, "Also print the full comparison table (with --baseline) or every candidate row's paired ratio (with --candidate)");
 
   // raybench backends / scenes
   CLI::App* backends_cmd = app.add_subcommand("backends", "List backend names");
@@ -367,6 +367,7 @@ int run(int argc, char** argv) {
         gate_accuracy(read_accuracy_csv(gate_accuracy_csv), gate_accuracy_csv, current.reference, gate_candidates, config, g);
       summary = fmt::format("{} against the reference {} in {}", fmt::join(gate_candidates, ", "), current.reference,
                             current.path);
+      if (gate_verbose) std::cout << format_paired_speeds(g) << "\n";
     } else {
       std::vector<ResultsFile> baseline_runs;
       for (const std::string& path : gate_baselines) baseline_runs.push_back(read_results_file(path));

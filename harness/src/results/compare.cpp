@@ -760,6 +760,9 @@ GateResult run_within_run_gate(const ResultsFile& run, const std::vector<std::st
       for (double v : ratios) logs.push_back(std::log(v));
       const double m = median(ratios);
       const SignedRank test = signed_rank_less(logs);
+      g.speeds.push_back({cand->at("scene"), cand->at("rayset"), candidate, cand->at("threads"), ratios.size(), m,
+                          *std::min_element(ratios.begin(), ratios.end()), *std::max_element(ratios.begin(), ratios.end()),
+                          test.p_value});
       const bool testable = ratios.size() >= min_rounds;
       if (!testable) {
         ++untestable;
@@ -823,6 +826,25 @@ GateResult run_within_run_gate(const ResultsFile& run, const std::vector<std::st
                                   "their speed is not gated (run with --reps {} or more)",
                                   untestable, untestable == 1 ? "" : "s", fewest_rounds, min_rounds, config.alpha, min_rounds));
   return g;
+}
+
+std::string format_paired_speeds(const GateResult& g) {
+  std::vector<std::vector<std::string>> table = {
+      {"scene", "rayset", "backend", "thr", "rounds", "x " + g.reference, "[min - max]", "p (slower)"}};
+  for (const PairedSpeed& s : g.speeds)
+    table.push_back({s.scene, s.rayset, s.backend, s.threads, std::to_string(s.rounds), fmt::format("{:.3f}", s.ratio),
+                     fmt::format("[{:.3f} - {:.3f}]", s.ratio_min, s.ratio_max), fmt::format("{:.2g}", s.p_value)});
+  std::vector<std::size_t> width(table[0].size(), 0);
+  for (const auto& row : table)
+    for (std::size_t i = 0; i < row.size(); ++i) width[i] = std::max(width[i], row[i].size());
+  std::string out;
+  for (const auto& row : table) {
+    std::string line;
+    for (std::size_t i = 0; i < row.size(); ++i) line += fmt::format("{:<{}}", row[i], width[i]) + "  ";
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    out += line + "\n";
+  }
+  return out;
 }
 
 std::string format_gate_json(const GateResult& g, const std::vector<std::string>& currents,

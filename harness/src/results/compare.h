@@ -197,12 +197,24 @@ struct GateFailure {
   double limit = kNoNumber;    // the config's threshold for this check
 };
 
+// The within-run gate's speed measurement of one candidate row (--verbose).
+struct PairedSpeed {
+  std::string scene, rayset, backend, threads;
+  std::size_t rounds = 0;
+  double ratio = 0, ratio_min = 0, ratio_max = 0;  // median and range of the paired ratios
+  double p_value = 1;                              // one-sided signed-rank test: slower than the reference
+};
+
 struct GateResult {
   std::string mode = "runs";   // runs | within-run
   std::string reference;       // the reference backend of the ratios
   std::vector<GateFailure> failures;
   std::vector<std::string> notes;
+  std::vector<PairedSpeed> speeds;  // within-run: every candidate row measured
 };
+
+// The within-run gate's speeds as an aligned table (gate --verbose).
+std::string format_paired_speeds(const GateResult& g);
 
 // With several current runs (independent processes of the same build), a
 // throughput regression counts only when every run shows it for the same
