@@ -208,6 +208,15 @@ class MissingRows(WithinRunTestCase):
         self.assertIn(f"no {CAND} row in", self.assertFailure(verdicts, "missing", scene="sphere")["message"])
         self.assertIn(f"no row of the reference {BASE}", self.assertFailure(verdicts, "missing", scene="cube")["message"])
 
+    def test_a_partial_run_fails(self):
+        # A candidate that crashed the process leaves the rows of the scenes before it.
+        path = self.write("run", run_rows(scenes=("terrain",)),
+                          rounds_metadata().replace('status = "complete"', 'status = "partial"\nprogress = "1 of 2 scenes"'))
+        result, verdicts = self.gate_json(path, expect=1)
+        f = self.assertFailure(verdicts, "missing")
+        self.assertEqual((f["scene"], f["threads"]), ("", None))
+        self.assertIn(f"FAIL: {path} is partial (1 of 2 scenes)", result.stdout)
+
     def test_a_candidate_missing_from_the_accuracy_csv_fails(self):
         current = self.write_run("run", run_rows())
         accuracy = self.write("accuracy", [accuracy_row("terrain", BASE), accuracy_row("terrain", CAND),

@@ -721,7 +721,14 @@ GateResult run_within_run_gate(const ResultsFile& run, const std::vector<std::st
       throw InputError("--candidate", fmt::format("'{}' is not a backend of {}; it has {}", c, run.path,
                                                   fmt::join(backends, ", ")));
   }
-  for (const std::string& n : partial_notes(run)) g.notes.push_back(n);
+  // A run that stopped early (a candidate that crashed the process, say)
+  // lacks the rows of its unfinished scenes: nothing here can pass them.
+  for (const std::string& n : partial_notes(run)) {
+    GateFailure f;
+    f.check = "missing";
+    f.message = n;
+    g.failures.push_back(f);
+  }
   const RowIndex index(run);
   // Every (scene, rayset, threads) of the run, in its order, by a row there.
   std::vector<const Row*> places;

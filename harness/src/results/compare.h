@@ -240,7 +240,10 @@ GateResult run_gate(const ResultsFile& baseline, const std::vector<ResultsFile>&
 //   - missing: a candidate's or the reference's row absent for a scene, ray
 //     set and threads that the run has (a note instead with
 //     fail_on_missing_rows = false);
-//   - rays: the two rows traced different ray counts.
+//   - rays: the two rows traced different ray counts;
+//   - missing, without a row: the run is partial (metadata status =
+//     "partial": it stopped before its last scene, perhaps by a candidate's
+//     crash), so the rows of its unfinished scenes cannot be judged.
 // Bad input (InputError): a run not timed in rounds ("re-run with this
 // raybench"), a candidate the run does not have (listing those it has), the
 // reference given as a candidate, no candidate.
