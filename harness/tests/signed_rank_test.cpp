@@ -1,8 +1,9 @@
 // Specification of the one-sided Wilcoxon signed-rank test (results/signed_rank.h)
 // that the within-run gate asks of paired log ratios: exact p-values as the
-// published tables of the signed-rank statistic give them (Wilcoxon, Katti
-// and Wilcox 1963; the critical values of every statistics textbook), ties
-// counted exactly, zeros dropped, and the normal approximation beyond 50 pairs.
+// published tables of the signed-rank statistic's lower-tail probabilities
+// give them (the one-sided 5 % critical values of n = 10, 15, 20: 10, 30,
+// 60), ties counted exactly, zeros dropped, and the normal approximation
+// beyond 50 pairs (its value computed by hand from the formula).
 #include "results/signed_rank.h"
 
 #include <cmath>
