@@ -257,11 +257,13 @@ TEST(WatertightNames, EveryBackendNamedWatertightLeaksNoRayUnlessNamedPlainBoxes
     EXPECT_EQ(backend_accuracy_class(name), "watertight") << name;
     for (const auto& [kind, rays] : sets) EXPECT_EQ(leaks_of(name, rays), 0u) << name << " on " << to_string(kind);
   }
-  EXPECT_EQ(plain_boxes, (std::vector<std::string>{"bvh2:watertight:plain_boxes", "bvh8:watertight:plain_boxes"}));
-  for (const std::string& name : plain_boxes) {
-    EXPECT_EQ(backend_accuracy_class(name), "fast") << name;
-    EXPECT_GT(leaks_of(name, sets[0].second), 0u) << name << " on vertex-aimed rays";
+  // Ours leak; any plain_boxes name (a family added in its own file too) is
+  // in the fast class, not the watertight one.
+  for (const char* n : {"bvh2:watertight:plain_boxes", "bvh8:watertight:plain_boxes"}) {
+    EXPECT_NE(std::find(plain_boxes.begin(), plain_boxes.end(), n), plain_boxes.end()) << n;
+    EXPECT_GT(leaks_of(n, sets[0].second), 0u) << n << " on vertex-aimed rays";
   }
+  for (const std::string& name : plain_boxes) EXPECT_EQ(backend_accuracy_class(name), "fast") << name;
 }
 
 // The bvh2 names of the triangle tests, from raybench/variants.h.
@@ -299,14 +301,20 @@ TEST(BackendNames, Bvh2StarIsBvh2WithEveryTriangleTestInTheVariantsList) {
 // Every family registers itself from its own file (RAYBENCH_BACKEND_FAMILY);
 // if the linker dropped one (a static library keeps only the objects that
 // something refers to) it would be missing here. The order is the families'
-// order keys.
+// order keys, and each family's names stand together. A family added in a
+// file of its own (docs/backends.md) takes its place among ours by its key
+// and needs no edit here.
 TEST(BackendRegistry, EveryFamilyIsRegisteredInItsOrder) {
-  std::vector<std::string> families;
+  const std::vector<std::string> ours{"embree", "bvh2", "bvh8", "bvh4", "reference"};
+  std::vector<std::string> families, ours_listed;
   for (const BackendInfo& b : list_backends()) {
     const std::string family = b.name.substr(0, b.name.find(':'));
-    if (families.empty() || families.back() != family) families.push_back(family);
+    if (!families.empty() && families.back() == family) continue;
+    EXPECT_EQ(std::count(families.begin(), families.end(), family), 0) << family << "'s names are not together";
+    families.push_back(family);
+    if (std::count(ours.begin(), ours.end(), family)) ours_listed.push_back(family);
   }
-  EXPECT_EQ(families, (std::vector<std::string>{"embree", "bvh2", "bvh8", "bvh4", "reference"}));
+  EXPECT_EQ(ours_listed, ours);
   EXPECT_EQ(backend_accuracy_class("reference"), "exact");
   EXPECT_EQ(backend_accuracy_class("bvh2:mt_seed"), "epsilon");
 }

@@ -191,12 +191,12 @@ TEST(Gate, ACurrentRunWithoutTheEmbreeRowFailsTheRowsBesideIt) {
   config.fail_on_missing_rows = false;  // the rule holds even when missing rows are allowed
   const GateResult g = run_gate(base, {read_results_file(current)}, config);
   ASSERT_EQ(g.failures.size(), 1u);
-  EXPECT_EQ(g.failures[0], "terrain/primary/bvh2/threads:1: no embree row for terrain/primary/threads:1 in " + current +
-                               ": its ratio to Embree cannot be checked");
+  EXPECT_EQ(g.failures[0].message, "terrain/primary/bvh2/threads:1: no embree row for terrain/primary/threads:1 in " + current +
+                               ": its ratio to embree cannot be checked");
   // The confirming run is held to it too: its verdict decides as much.
   const GateResult two = run_gate(base, {base, read_results_file(current)}, config);
   ASSERT_EQ(two.failures.size(), 1u);
-  EXPECT_NE(two.failures[0].find(" in " + current + ":"), std::string::npos);
+  EXPECT_NE(two.failures[0].message.find(" in " + current + ":"), std::string::npos);
 }
 
 TEST(Gate, APartialRunIsNamedInANote) {
@@ -209,6 +209,46 @@ TEST(Gate, APartialRunIsNamedInANote) {
   bool named = false;
   for (const std::string& n : g.notes) named = named || n.rfind(current + " is partial (3 of 4 scenes)", 0) == 0;
   EXPECT_TRUE(named);
+}
+
+// Issue 30: runs timed in rounds pair their samples; every ratio is to the file's own reference.
+TEST(Compare, ARunTimedInRoundsPairsEachSampleWithTheReferencesOfTheSameRound) {
+  TempDir dir;
+  // The machine swings from round to round; the candidate is 0.8x the reference in each round.
+  const std::string path = dir.write("run.csv", csv({row({{"backend", "base"}, {"reference", "base"}, {"mrays_s_samples", "10;5;20"}}),
+                                                     row({{"backend", "cand"}, {"reference", "base"}, {"mrays_s_samples", "8;4;16"}})}));
+  dir.write("run.meta.toml", "reference_backend = \"base\"\ntiming = \"rounds\"\n");
+  const ResultsFile f = read_results_file(path);
+  EXPECT_EQ(f.reference, "base");
+  EXPECT_TRUE(f.paired);
+  const Comparison c = compare_results(f, f, {});
+  ASSERT_EQ(c.rows.size(), 2u);
+  EXPECT_EQ(c.rows[0].ratio.verdict, Verdict::kNotApplicable);  // the reference's own row
+  EXPECT_DOUBLE_EQ(c.rows[1].ratio.current, 0.8);
+  // Pooled with another run, each sample keeps the ratio of its own round.
+  const std::string other = dir.write("other.csv", csv({row({{"backend", "base"}, {"reference", "base"}, {"mrays_s_samples", "30;40;50"}}),
+                                                        row({{"backend", "cand"}, {"reference", "base"}, {"mrays_s_samples", "27;36;45"}})}));
+  dir.write("other.meta.toml", "reference_backend = \"base\"\ntiming = \"rounds\"\n");
+  const ResultsFile pooled = pool_runs({f, read_results_file(other)});
+  EXPECT_FALSE(pooled.paired);
+  const Comparison p = compare_results(pooled, pooled, {});
+  EXPECT_DOUBLE_EQ(p.rows[1].ratio.current, 0.85);  // the median of 0.8, 0.8, 0.8, 0.9, 0.9, 0.9
+}
+
+TEST(ReadResultsFile, TheReferenceComesFromTheMetadataTheRowsOrIsEmbree) {
+  TempDir dir;
+  const std::string path = dir.write("r.csv", csv({row({{"reference", ""}}), row({{"backend", "bvh2"}, {"reference", ""}})}));
+  EXPECT_EQ(read_results_file(path).reference, "embree");  // older files
+  EXPECT_FALSE(read_results_file(path).paired);
+  const std::string named = dir.write("n.csv", csv({row({{"reference", "bvh2"}}), row({{"backend", "bvh2"}, {"reference", "bvh2"}})}));
+  EXPECT_EQ(read_results_file(named).reference, "bvh2");
+  const std::string mixed = dir.write("m.csv", csv({row({{"reference", "bvh2"}}), row({{"backend", "bvh2"}, {"reference", "embree"}})}));
+  EXPECT_NE(input_error_of([&] { read_results_file(mixed); }).find(mixed + ": line 3 (terrain/primary/bvh2/threads:1), column 'reference'"),
+            std::string::npos);
+  // Two files with different references do not compare.
+  const std::string error = input_error_of([&] { compare_results(read_results_file(path), read_results_file(named), {}); });
+  EXPECT_NE(error.find(named), std::string::npos) << error;
+  EXPECT_NE(error.find(path), std::string::npos) << error;
 }
 
 // 100,000 rows: 50,000 scenes, each an Embree row and a bvh2 row beside it.

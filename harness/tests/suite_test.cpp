@@ -13,6 +13,7 @@
 #include "suite/results_table.h"
 #include "suite/scene_selection.h"
 #include "suite/settings_rules.h"
+#include "suite/suite_run.h"
 #include "test_util.h"
 
 namespace raybench {
@@ -453,6 +454,96 @@ TEST(Suite, TheAccuracyTableShowsTheRefereesVerdictsAsRayCounts) {
   EXPECT_EQ(line_of("  shadow"), "  shadow  bvh2:mt_seed epsilon    2000    1000      0     500      2      -      -  "
                                  "      -        -");
   for (const std::string& line : {line_of("  rayset"), line_of("  diffuse")}) EXPECT_LE(line.size(), 100u);
+}
+
+TEST(Suite, TheTimingReferenceIsReadFromTheDefaultsAndRecordsWhereItWasGiven) {
+  TempDir dir;
+  const std::string scene = "[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\n";
+  const Suite s =
+      load_suite(dir.write("s.toml", "[defaults]\nbackends = [\"embree\", \"bvh2\"]\nreference = \"bvh2\"\n" + scene));
+  EXPECT_EQ(s.settings.reference, "bvh2");
+  EXPECT_EQ(s.settings.reference_given, dir.file("s.toml") + ": 'defaults.reference'");
+  EXPECT_EQ(timing_reference(s.settings), "bvh2");
+  EXPECT_EQ(load_suite(dir.write("t.toml", "[defaults]\nrays = 10\n" + scene)).settings.reference, "");
+}
+
+TEST(Suite, AManifestsTimingReferenceMustBeOneNameAndOneOfTheRunsBackends) {
+  TempDir dir;
+  const auto path = [&](const std::string& reference) {
+    return dir.write("s.toml", "[defaults]\nbackends = [\"embree\", \"bvh2\"]\nreference = " + reference +
+                                   "\n[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\n");
+  };
+  EXPECT_NE(error_of(path("3")).find("'defaults.reference': expected a string"), std::string::npos);
+  EXPECT_NE(error_of(path("\"\"")).find("'defaults.reference': must be one of the run's backend names"),
+            std::string::npos);
+  EXPECT_NE(error_of(path("\"embree,bvh2\"")).find("'defaults.reference': must be one of the run's backend names"),
+            std::string::npos);
+  const Suite s = load_suite(path("\"bvh8\""));  // a backend name, but not one of the run's
+  const std::string error = testing::input_error_of([&] { timing_reference(s.settings); });
+  EXPECT_NE(error.find(dir.file("s.toml") + ": 'defaults.reference': bvh8 is not one of the run's backends (embree, "
+                                            "bvh2)"),
+            std::string::npos)
+      << error;
+}
+
+TEST(Suite, WithoutAReferenceTheTimingReferenceIsEmbreeWhenTheRunHasItAndNoneOtherwise) {
+  SuiteSettings s;
+  s.backends = {"bvh2", "embree"};
+  EXPECT_EQ(timing_reference(s), "embree");
+  s.backends = {"bvh2", "bvh8"};
+  EXPECT_EQ(timing_reference(s), "");
+  s.reference = "bvh8";
+  EXPECT_EQ(timing_reference(s), "bvh8");
+  s.reference = "embree";
+  EXPECT_EQ(testing::input_error_of([&] { timing_reference(s); }),
+            "--reference: embree is not one of the run's backends (bvh2, bvh8): add it to --backend or name one of them");
+}
+
+TEST(SettingsRules, AReferenceIsOneBackendName) {
+  EXPECT_EQ(reference_setting(GivenValue::from_flag("--reference", "plugin:build/libmy.so:fast")),
+            "plugin:build/libmy.so:fast");
+  for (const char* bad : {"", "embree,bvh2", "a\nb"})
+    EXPECT_NE(testing::input_error_of([&] { reference_setting(GivenValue::from_flag("--reference", bad)); })
+                  .find("--reference: must be one of the run's backend names"),
+              std::string::npos)
+        << bad;
+}
+
+TEST(Suite, TheTableShowsTheRatioToTheTimingReferenceAndNamesItInTheHeader) {
+  ResultRow old_plugin = timed_row(10, 11, 12), new_plugin = timed_row(10, 13, 14), embree = timed_row(5, 6, 7);
+  old_plugin.backend = "plugin:old.so";
+  old_plugin.plugin = "my_bvh";
+  new_plugin.backend = "plugin:build/libnew.so:fast";
+  new_plugin.plugin = "my_bvh";
+  embree.backend = "embree";
+  for (ResultRow* r : {&old_plugin, &new_plugin, &embree}) r->reference = "plugin:old.so";
+  old_plugin.ratio_to_reference = 1.0;
+  new_plugin.ratio_to_reference = 1.25;
+  embree.ratio_to_reference = 0.5;
+  new_plugin.ratio_to_embree = 2.0;  // not what the table shows
+  const std::string table = format_results_table({old_plugin, new_plugin, embree});
+  const auto line_of = [&](const std::string& part) {
+    const std::size_t at = table.find(part);
+    if (at == std::string::npos) return std::string();
+    const std::size_t begin = table.rfind('\n', at) + 1;
+    return table.substr(begin, table.find('\n', at) - begin);
+  };
+  EXPECT_NE(line_of("x plugin:old.so").find("backend"), std::string::npos) << table;
+  EXPECT_NE(line_of("my_bvh (plugin:old.so)").find(" 1.00 "), std::string::npos) << table;
+  EXPECT_NE(line_of("my_bvh (plugin:build/libnew.so:fast)").find(" 1.25 "), std::string::npos) << table;
+  EXPECT_EQ(line_of("my_bvh (plugin:build/libnew.so:fast)").find("2.00"), std::string::npos) << table;
+  EXPECT_NE(line_of("  primary embree ").find(" 0.50 "), std::string::npos) << table;
+  // The ratio column sits under its header, right-aligned.
+  const std::string header = line_of("x plugin:old.so");
+  const std::size_t end = header.find("x plugin:old.so") + std::string("x plugin:old.so").size();
+  EXPECT_EQ(line_of("my_bvh (plugin:old.so)").substr(end - 4, 4), "1.00") << table;
+}
+
+TEST(Suite, ARunWithoutATimingReferenceShowsNoRatio) {
+  ResultRow r = timed_row(10, 11, 12);
+  r.ratio_to_embree = 0;
+  const std::string table = format_results_table({r});
+  EXPECT_NE(table.find("x ref"), std::string::npos) << table;
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "accuracy/accuracy_gate.h"
 #include "accuracy/kernel_accuracy.h"
 #include "measure/agreement.h"
 #include "build_info.h"
@@ -27,6 +28,7 @@
 #include "io/npy.h"
 #include "scene/procedural.h"
 #include "rays/rayset.h"
+#include "rays/screening.h"
 #include "scene/scene.h"
 #include "suite/scene_selection.h"
 #include "suite/settings_rules.h"
@@ -156,7 +158,7 @@ int run(int argc, char** argv) {
   RunOptions run_options;
   std::string suite_path = kDefaultSuite;
   std::vector<std::string> run_raysets, run_backends, run_threads;
-  std::string run_rays, run_reps, run_build_reps, run_seed, run_min_time, run_warmup;
+  std::string run_rays, run_reps, run_build_reps, run_seed, run_min_time, run_warmup, run_reference;
   bool no_interleave = false, list_only = false;
   run_options.out_csv = kDefaultOut;
   run_options.rays_dir = kDefaultRaysDir;
@@ -172,14 +174,18 @@ int run(int argc, char** argv) {
   run_cmd->add_option("--backend,-b", run_backends, "Backends, e.g. embree,embree:high,bvh2 (see 'raybench backends'); 'bvh2:*' is bvh2 with every triangle test")
       ->delimiter(',');
   run_cmd->add_option("--threads,-t", run_threads, "Thread counts, e.g. 1,2 (default: 1)")->delimiter(',')->type_name("INT");
-  run_cmd->add_option("--reps", run_reps, "Timed repetitions per case; the median is reported (default: 5)")->type_name("INT");
+  run_cmd->add_option("--reps", run_reps, "Timed rounds: each round traces every case of a scene once, in a shuffled order; the median is reported (default: 5)")->type_name("INT");
+  run_cmd->add_option("--reference", run_reference,
+                      "Backend of the run that ratio_to_reference and the table's 'x NAME' are relative to, paired round by "
+                      "round, e.g. plugin:old.so (default: embree when the run has it)")
+      ->type_name("NAME");
   run_cmd->add_option("--build-reps", run_build_reps, "Timed rounds of builds per backend, interleaved across backends after one untimed build each; a build shorter than --min-time is repeated within its round (default: 3)")->type_name("INT");
   run_cmd->add_option("--seed", run_seed, "Ray generation seed (default: 1)")->type_name("INT");
   run_cmd->add_option("--min-time", run_min_time, "Minimum seconds per repetition, of a trace or of a round of builds (default: 0.05)")->type_name("SECONDS");
-  run_cmd->add_option("--warmup", run_warmup, "Untimed warm-up seconds per case (default: 0.05)")->type_name("SECONDS");
+  run_cmd->add_option("--warmup", run_warmup, "Untimed warm-up seconds per case, before its first round (default: 0.05)")->type_name("SECONDS");
   run_cmd->add_option("--out,-o", run_options.out_csv, "Results CSV; metadata goes beside it as .meta.toml")->capture_default_str();
   run_cmd->add_option("--rays-dir", run_options.rays_dir, "Where ray sets are stored and reused")->capture_default_str();
-  run_cmd->add_flag("--no-interleave", no_interleave, "Run each case's repetitions back to back instead of interleaved");
+  run_cmd->add_flag("--no-interleave", no_interleave, "Run every round's cases in the same order (backends as listed) instead of a shuffled one");
   run_cmd->add_flag("--list", list_only, "List the suite's scenes and whether they are available, then exit");
   run_cmd->add_option("--accuracy", run_options.accuracy_csv,
                       "Also judge every ray with the exact referee and write the accuracy CSV here "
@@ -250,8 +256,8 @@ int run(int argc, char** argv) {
   bool compare_force = false;
   CompareOptions compare_options;
   CLI::App* compare_cmd = app.add_subcommand(
-      "compare", "Compare two results CSVs row by row: throughput and ratio to Embree with a noise-aware verdict, "
-                 "deterministic columns exactly");
+      "compare", "Compare two results CSVs row by row: throughput and ratio to the runs' reference backend (embree "
+                 "unless the run chose another) with a noise-aware verdict, deterministic columns exactly");
   compare_cmd->add_option("base", compare_base, "Baseline results CSV")->required();
   compare_cmd->add_option("current", compare_current, "Results CSV to compare with it")->required();
   compare_cmd->add_option("--format,-f", compare_format, "table, md or json")
@@ -267,20 +273,29 @@ int run(int argc, char** argv) {
 
   // raybench gate
   std::string gate_config = default_paths().gate_config;
-  std::vector<std::string> gate_baselines, gate_currents;
+  std::vector<std::string> gate_baselines, gate_currents, gate_candidates;
+  std::string gate_accuracy_csv, gate_json;
   bool gate_verbose = false;
   CLI::App* gate_cmd = app.add_subcommand(
-      "gate", "Fail (exit 1) when the current results regress against a baseline beyond the thresholds of a gate config");
+      "gate", "Fail (exit 1) when the current results regress against a baseline (--baseline), or when a candidate "
+              "backend is slower or less accurate than the run's reference backend (--candidate), beyond the "
+              "thresholds of a gate config");
   gate_cmd->add_option("--baseline", gate_baselines,
                        "Baseline results CSV; give it more than once to pool independent runs of the baseline "
-                       "(each repetition keeps the ratio to Embree of its own run)")
-      ->required();
+                       "(each repetition keeps the ratio to the reference of its own run)");
   gate_cmd->add_option("--current", gate_currents,
-                       "Current results CSV; give it twice (two independent runs) to count a throughput "
-                       "regression only when both show it")
+                       "Current results CSV; with --baseline, give it twice (two independent runs) to count a "
+                       "throughput regression only when both show it")
       ->required();
+  gate_cmd->add_option("--candidate", gate_candidates,
+                       "Gate within the --current run (no --baseline): this backend, as named in the run (e.g. "
+                       "plugin:cand.so), against the run's reference backend, round by round; more than once for several");
+  gate_cmd->add_option("--accuracy", gate_accuracy_csv,
+                       "With --candidate: the run's accuracy CSV (run --accuracy); a candidate whose referee error counts "
+                       "exceed the reference's fails");
+  gate_cmd->add_option("--json", gate_json, "Also write the verdicts as JSON to this file (docs/gating.md)");
   gate_cmd->add_option("--config", gate_config, "Thresholds (TOML)")->capture_default_str();
-  gate_cmd->add_flag("--verbose,-v", gate_verbose, "Also print the full comparison table");
+  gate_cmd->add_flag("--verbose,-v", gate_verbose, "Also print the full comparison table (with --baseline) or every candidate row's paired ratio (with --candidate)");
 
   // raybench backends / scenes
   CLI::App* backends_cmd = app.add_subcommand("backends", "List backend names");
@@ -315,8 +330,8 @@ int run(int argc, char** argv) {
     if (const auto diffs = machine_differences(base, current); !diffs.empty() && !compare_force) {
       std::string all;
       for (const auto& d : diffs) all += (all.empty() ? "" : "; ") + d;
-      throw InputError(compare_current, "not comparable with " + compare_base + ": " + all +
-                                            " (ratios to Embree still are: use --force to compare anyway)");
+      throw InputError(compare_current, "not comparable with " + compare_base + ": " + all + " (ratios to " +
+                                            current.reference + " still are: use --force to compare anyway)");
     }
     const Comparison c = compare_results(base, current, compare_options);
     const OutputFormat format = compare_format == "md" ? OutputFormat::kMarkdown
@@ -329,31 +344,60 @@ int run(int argc, char** argv) {
     return 0;
   }
   if (*gate_cmd) {
+    const bool within_run = !gate_candidates.empty();
+    if (within_run && !gate_baselines.empty())
+      throw InputError("--candidate", "gates within one run, --baseline against another run: give one or the other");
+    if (!within_run && gate_baselines.empty())
+      throw InputError("gate", "give --baseline FILE (gate against another run) or --candidate NAME (within the --current run)");
+    if (within_run && gate_currents.size() != 1)
+      throw InputError("--current", "the gate within one run takes one --current run");
+    if (!within_run && !gate_accuracy_csv.empty())
+      throw InputError("--accuracy", "judges candidates within one run: give --candidate NAME, not --baseline");
     check_input_file(gate_config, "gate config (TOML)");
     for (const std::string& path : gate_baselines) check_input_file(path, "results CSV");
     for (const std::string& path : gate_currents) check_input_file(path, "results CSV");
+    if (!gate_accuracy_csv.empty()) check_input_file(gate_accuracy_csv, "accuracy CSV");
+    std::vector<FileArg> gate_inputs;
+    for (const std::string& path : gate_baselines) gate_inputs.push_back({"--baseline", path, "--baseline " + path});
+    for (const std::string& path : gate_currents) gate_inputs.push_back({"--current", path, "--current " + path});
+    gate_inputs.push_back({"--accuracy", gate_accuracy_csv, "--accuracy " + gate_accuracy_csv});
+    gate_inputs.push_back({"--config", gate_config, "--config " + gate_config});
+    check_outputs({output("--json", gate_json)}, gate_inputs);
     const GateConfig config = load_gate_config(gate_config);
-    std::vector<ResultsFile> baseline_runs;
-    for (const std::string& path : gate_baselines) baseline_runs.push_back(read_results_file(path));
-    const ResultsFile baseline = pool_runs(baseline_runs);
     std::vector<ResultsFile> currents;
-    for (const std::string& path : gate_currents) {
-      currents.push_back(read_results_file(path));
-      if (currents.back().rows.empty()) throw InputError(path, "has no result rows");
-    }
+    for (const std::string& path : gate_currents) currents.push_back(read_results_file(path));
     const ResultsFile& current = currents.front();
-    const GateResult g = run_gate(baseline, currents, config);
-    if (gate_verbose) {
-      CompareOptions o;
-      o.alpha = config.alpha;
-      o.min_effect = config.max_ratio_drop;
-      std::cout << format_comparison(compare_results(baseline, current, o), baseline, current, OutputFormat::kTable,
-                                     ::isatty(1)) << "\n";
+    GateResult g;
+    std::string summary;
+    if (within_run) {
+      g = run_within_run_gate(current, gate_candidates, config);
+      if (!gate_accuracy_csv.empty())
+        gate_accuracy(read_accuracy_csv(gate_accuracy_csv), gate_accuracy_csv, current.reference, gate_candidates, config, g);
+      summary = fmt::format("{} against the reference {} in {}", fmt::join(gate_candidates, ", "), current.reference,
+                            current.path);
+      if (gate_verbose) std::cout << format_paired_speeds(g) << "\n";
+    } else {
+      std::vector<ResultsFile> baseline_runs;
+      for (const std::string& path : gate_baselines) baseline_runs.push_back(read_results_file(path));
+      const ResultsFile baseline = pool_runs(baseline_runs);
+      g = run_gate(baseline, currents, config);
+      if (gate_verbose) {
+        CompareOptions o;
+        o.alpha = config.alpha;
+        o.min_effect = config.max_ratio_drop;
+        std::cout << format_comparison(compare_results(baseline, current, o), baseline, current, OutputFormat::kTable,
+                                       ::isatty(1)) << "\n";
+      }
+      summary = fmt::format("{} rows compared against {}", current.rows.size(), baseline.path);
     }
     for (const auto& n : g.notes) std::cout << "note: " << n << "\n";
-    for (const auto& f : g.failures) std::cout << "FAIL: " << f << "\n";
-    std::cout << fmt::format("gate: {} ({} rows compared against {}, {} failure{})\n", g.failures.empty() ? "PASS" : "FAIL",
-                             current.rows.size(), baseline.path, g.failures.size(), g.failures.size() == 1 ? "" : "s");
+    for (const auto& f : g.failures) std::cout << "FAIL: " << f.message << "\n";
+    std::cout << fmt::format("gate: {} ({}, {} failure{})\n", g.failures.empty() ? "PASS" : "FAIL", summary,
+                             g.failures.size(), g.failures.size() == 1 ? "" : "s");
+    if (!gate_json.empty()) {
+      const std::string json = format_gate_json(g, gate_currents, gate_baselines, gate_candidates);
+      write_file_atomically(gate_json, [&](std::ostream& o) { o << json; });
+    }
     return g.failures.empty() ? 0 : 1;
   }
   if (*accuracy_kernels_cmd) {
@@ -435,6 +479,11 @@ int run(int argc, char** argv) {
     override_with("--seed", run_seed, seed_setting, &SuiteSettings::seed);
     override_with("--min-time", run_min_time, min_time_setting, &SuiteSettings::min_time);
     override_with("--warmup", run_warmup, warmup_setting, &SuiteSettings::warmup);
+    if (run_cmd->count("--reference"))
+      overrides.push_back([v = flag_value("--reference", run_reference, reference_setting)](SuiteSettings& s) {
+        s.reference = v;
+        s.reference_given = "--reference";
+      });
     check_named("--out", run_options.out_csv);
     if (run_options.rays_dir.empty()) throw InputError("--rays-dir", "must name a folder, got ''");
     check_outputs({output("--out", run_options.out_csv), metadata_of("--out", run_options.out_csv),
@@ -487,7 +536,9 @@ int run(int argc, char** argv) {
     Suite storage;
     const Suite* suite = suite_if_readable(trace_suite, trace_cmd->count("--suite") > 0, storage);
     std::unique_ptr<Backend> backend = make_backend(trace_backend, {threads});
-    const std::vector<Ray> rays = read_ray_file(trace_rays);
+    // What every backend traces (rays/screening.h); untraceable rays answer misses.
+    const ScreenedRays screened = screen_rays(read_ray_file(trace_rays));
+    const std::vector<Ray>& rays = screened.rays;
     const SceneArg s = resolve_scene(trace_scene, suite);
     const TraceExecutor executor(threads);
     executor.run([&] { backend->build(s.scene); });
@@ -495,6 +546,7 @@ int run(int argc, char** argv) {
     if (trace_occluded) {
       std::vector<std::uint8_t> occ(rays.size());
       executor.occluded(*backend, rays, occ);
+      force_misses(screened, occ);
       std::vector<double> out(occ.begin(), occ.end());
       for (std::uint8_t o : occ) hits += o;
       write_npy_f64(trace_out, out, rays.size(), 1);
@@ -503,6 +555,7 @@ int run(int argc, char** argv) {
     } else {
       std::vector<Hit> h(rays.size());
       executor.intersect(*backend, rays, h);
+      force_misses(screened, h);
       std::vector<double> out(rays.size() * 4);
       for (std::size_t i = 0; i < h.size(); ++i) {
         out[4 * i + 0] = h[i].t;

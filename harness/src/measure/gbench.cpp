@@ -1,10 +1,13 @@
 // The Google Benchmark glue (measure/gbench.h): one initialisation per
-// process and a reporter that keeps every repetition's raw sample.
+// process, a reporter that keeps every repetition's raw sample, and timing
+// in rounds.
 #include "measure/gbench.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <iostream>
+#include <numeric>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -16,6 +19,16 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double paired_median_ratio(const std::vector<double>& samples, const std::vector<double>& reference) {
+  if (samples.empty() || samples.size() != reference.size()) return std::nan("");
+  std::vector<double> ratios(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (!(reference[i] > 0)) return std::nan("");
+    ratios[i] = samples[i] / reference[i];
+  }
+  return median(std::move(ratios));
 }
 
 void initialize_google_benchmark(const std::vector<std::string>& flags) {
@@ -35,7 +48,14 @@ void initialize_google_benchmark(const std::vector<std::string>& flags) {
 CollectingReporter::CollectingReporter(std::string counter, double scale, std::string unit, std::size_t total_cases)
     : counter_(std::move(counter)), unit_(std::move(unit)), scale_(scale), total_(total_cases) {}
 
-double CollectingReporter::convert(double per_second) const { return scale_ > 0 ? per_second * scale_ : 1e9 / per_second; }
+namespace {
+
+// A rate per second in the unit kept: times scale, or (scale 0) 1e9 / rate.
+double convert_rate(double per_second, double scale) { return scale > 0 ? per_second * scale : 1e9 / per_second; }
+
+}  // namespace
+
+double CollectingReporter::convert(double per_second) const { return convert_rate(per_second, scale_); }
 
 void CollectingReporter::ReportRuns(const std::vector<Run>& runs) {
   for (const Run& run : runs) {
@@ -64,6 +84,98 @@ const std::vector<double>& CollectingReporter::samples(const std::string& name) 
   const auto it = samples_.find(name);
   if (it == samples_.end() || it->second.empty()) throw std::runtime_error(name + ": benchmark produced no measurement");
   return it->second;
+}
+
+namespace {
+
+std::uint64_t splitmix64(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+// One round's single repetition of every case: its sample and the iteration
+// count it ran, or the error it reported.
+class RoundReporter : public benchmark::BenchmarkReporter {
+ public:
+  RoundReporter(const std::string& counter, double scale) : counter_(counter), scale_(scale) {}
+  bool ReportContext(const Context&) override { return true; }
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& run : runs) {
+      if (run.run_type != Run::RT_Iteration) continue;
+      const std::string& name = run.run_name.function_name;
+      if (run.error_occurred) {
+        errors[name] = run.error_message;
+        continue;
+      }
+      const auto counter = run.counters.find(counter_);
+      if (counter == run.counters.end()) {
+        errors[name] = "no counter '" + counter_ + "'";
+        continue;
+      }
+      results[name] = {convert_rate(counter->second.value, scale_), run.iterations};
+    }
+  }
+  void Finalize() override {}
+
+  std::map<std::string, std::pair<double, benchmark::IterationCount>> results;
+  std::map<std::string, std::string> errors;
+
+ private:
+  std::string counter_;
+  double scale_;
+};
+
+}  // namespace
+
+std::vector<std::size_t> round_order(std::size_t n, std::uint64_t seed, int round) {
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::uint64_t state = seed ^ (0x2545f4914f6cdd1dull * (static_cast<std::uint64_t>(round) + 1));
+  for (std::size_t i = n; i > 1; --i) {
+    // An unbiased index in [0, i): reject the top remainder of the 64-bit range.
+    const std::uint64_t limit = ~std::uint64_t{0} - (~std::uint64_t{0} % i);
+    std::uint64_t x = splitmix64(state);
+    while (x >= limit) x = splitmix64(state);
+    std::swap(order[i - 1], order[static_cast<std::size_t>(x % i)]);
+  }
+  return order;
+}
+
+std::vector<std::vector<double>> run_rounds(const std::vector<RoundCase>& cases, const RoundSettings& settings,
+                                            const std::function<void(int round, double seconds)>& after_round) {
+  std::vector<std::vector<double>> samples(cases.size());
+  std::vector<benchmark::IterationCount> iterations(cases.size(), 0);
+  if (cases.empty()) return samples;  // Google Benchmark would complain of no benchmark to run
+  for (int round = 0; round < settings.rounds; ++round) {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<std::size_t> order(cases.size());
+    if (settings.shuffle) order = round_order(cases.size(), settings.seed, round);
+    else std::iota(order.begin(), order.end(), std::size_t{0});
+    benchmark::ClearRegisteredBenchmarks();
+    for (const std::size_t i : order) {
+      benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(cases[i].name.c_str(), cases[i].body);
+      b->Repetitions(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+      if (round == 0) b->MinTime(settings.min_time)->MinWarmUpTime(settings.warmup);
+      else b->Iterations(iterations[i]);
+    }
+    RoundReporter reporter(settings.counter, settings.scale);
+    benchmark::RunSpecifiedBenchmarks(&reporter);
+    benchmark::ClearRegisteredBenchmarks();
+    for (std::size_t i = 0; i < cases.size(); ++i) {
+      const std::string& name = cases[i].name;
+      if (const auto e = reporter.errors.find(name); e != reporter.errors.end())
+        throw std::runtime_error(name + ": benchmark failed: " + e->second);
+      const auto r = reporter.results.find(name);
+      if (r == reporter.results.end()) throw std::runtime_error(name + ": benchmark produced no measurement");
+      samples[i].push_back(r->second.first);
+      if (round == 0) iterations[i] = std::max<benchmark::IterationCount>(1, r->second.second);
+    }
+    if (after_round)
+      after_round(round, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  return samples;
 }
 
 }  // namespace raybench

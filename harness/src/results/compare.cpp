@@ -4,17 +4,20 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <string_view>
 #include <unordered_map>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <toml++/toml.h>
 
 #include "io/error.h"
 #include "measure/gbench.h"
 #include "io/input_file.h"
 #include "results/mann_whitney.h"
+#include "results/signed_rank.h"
 #include "results/metadata.h"
 #include "results/results_csv.h"
 
@@ -34,13 +37,12 @@ std::string row_key(const Row& r) {
 std::string match_key(const Row& r) {
   return r.at("scene") + '\n' + r.at("rayset") + '\n' + r.at("backend") + '\n' + r.at("threads");
 }
-// Every ratio_to_embree is a backend's throughput over this backend's.
-constexpr const char* kReferenceBackend = "embree";
-// The key of the Embree row measured beside `r`: same scene, rayset, threads.
-std::string reference_key(const Row& r) {
-  return r.at("scene") + '\n' + r.at("rayset") + '\n' + kReferenceBackend + '\n' + r.at("threads");
+// The key of the row of backend `backend` measured beside `r`: same scene, rayset, threads.
+std::string key_beside(const Row& r, const std::string& backend) {
+  return r.at("scene") + '\n' + r.at("rayset") + '\n' + backend + '\n' + r.at("threads");
 }
-bool is_reference(const Row& r) { return r.at("backend") == kReferenceBackend; }
+// Whether `r` is a row of the file's reference backend, whose ratio is 1 by definition.
+bool is_reference(const Row& r, const ResultsFile& f) { return r.at("backend") == f.reference; }
 
 // Each row of a file by its match_key.
 class RowIndex {
@@ -51,8 +53,12 @@ class RowIndex {
   }
   // The row with the same key as `like`, if any.
   const Row* find(const Row& like) const { return at(match_key(like)); }
-  // The Embree row measured beside `row` in the same run, if any.
-  const Row* reference_beside(const Row& row) const { return at(reference_key(row)); }
+  // The row of `backend` measured beside `row` in the same run, if any.
+  const Row* beside(const Row& row, const std::string& backend) const { return at(key_beside(row, backend)); }
+  // The reference backend's row measured beside `row` in the same run, if any.
+  const Row* reference_beside(const Row& row) const { return beside(row, file_.reference); }
+  // The position of `row` in the file (for its line).
+  std::size_t position(const Row& row) const { return static_cast<std::size_t>(&row - file_.rows.data()); }
 
  private:
   const Row* at(const std::string& key) const {
@@ -121,16 +127,57 @@ void check_row(const ResultsFile& f, std::size_t i) {
     throw bad("leaks", fmt::format("'{}' is not a count of rays (empty, or a whole number >= 0)", leaks));
 }
 
-// Throws InputError naming the first row of a backend other than Embree
-// without the Embree row of its scene, ray set and threads in the same file.
+// Throws InputError naming the first row of a backend other than the
+// reference without the reference's row of its scene, ray set and threads
+// in the same file.
 void require_reference_rows(const ResultsFile& f) {
   const RowIndex index(f);
   for (std::size_t i = 0; i < f.rows.size(); ++i)
-    if (!is_reference(f.rows[i]) && !index.reference_beside(f.rows[i]))
-      throw InputError(f.path, fmt::format("{}: no embree row for {}/{}/threads:{}: a baseline needs the embree "
+    if (!is_reference(f.rows[i], f) && !index.reference_beside(f.rows[i]))
+      throw InputError(f.path, fmt::format("{}: no {} row for {}/{}/threads:{}: a baseline needs the {} "
                                            "backend's rows, the reference of every ratio the gate checks",
-                                           row_where(f, i), f.rows[i].at("scene"), f.rows[i].at("rayset"),
-                                           f.rows[i].at("threads")));
+                                           row_where(f, i), f.reference, f.rows[i].at("scene"), f.rows[i].at("rayset"),
+                                           f.rows[i].at("threads"), f.reference));
+}
+
+// The reference of `f` (see ResultsFile::reference), checked against every
+// row's `reference` column; and, in a file timed in rounds, every row's
+// sample count against its reference row's. Throws InputError.
+void read_reference(ResultsFile& f) {
+  const std::string meta = metadata_path_for(f.path);
+  const auto declared = f.metadata.find("reference_backend");
+  const bool from_metadata = declared != f.metadata.end() && !declared->second.empty();
+  std::size_t first_column = f.rows.size();  // the first row that names a reference
+  for (std::size_t i = 0; i < f.rows.size(); ++i) {
+    const auto it = f.rows[i].find("reference");
+    const std::string named = it == f.rows[i].end() ? "" : it->second;
+    if (named.empty()) continue;
+    if (from_metadata && named != declared->second)
+      throw InputError(f.path, fmt::format("{}, column 'reference': '{}', but {} says reference_backend = '{}'",
+                                           row_where(f, i), named, meta, declared->second));
+    if (!from_metadata && first_column < f.rows.size() && named != f.rows[first_column].at("reference"))
+      throw InputError(f.path, fmt::format("{}, column 'reference': '{}', but line {} says '{}': one run has one reference",
+                                           row_where(f, i), named, f.lines.at(first_column),
+                                           f.rows[first_column].at("reference")));
+    if (first_column == f.rows.size()) first_column = i;
+  }
+  if (from_metadata) f.reference = declared->second;
+  else if (first_column < f.rows.size()) f.reference = f.rows[first_column].at("reference");
+  const auto timing = f.metadata.find("timing");
+  f.paired = timing != f.metadata.end() && timing->second == "rounds";
+  if (!f.paired) return;
+  const RowIndex index(f);
+  for (std::size_t i = 0; i < f.rows.size(); ++i) {
+    const Row* ref = index.reference_beside(f.rows[i]);
+    if (!ref || ref == &f.rows[i]) continue;
+    const std::size_t mine = parse_samples(f.rows[i].at("mrays_s_samples")).size();
+    const std::size_t theirs = parse_samples(ref->at("mrays_s_samples")).size();
+    if (mine != theirs)
+      throw InputError(f.path, fmt::format("{}, column 'mrays_s_samples': {} samples, but its {} row ({}) has {}: "
+                                           "timed in rounds ({}), the samples pair round by round",
+                                           row_where(f, i), mine, f.reference, row_where(f, index.position(*ref)), theirs,
+                                           meta));
+  }
 }
 
 // The columns that are a pure function of the rays, the scene and the code.
@@ -159,20 +206,29 @@ SampleComparison compare_samples(const std::vector<double>& base, const std::vec
   return c;
 }
 
-// Each repetition of a row divided by the median of the Embree row measured
-// in the same run (same scene, ray set, threads); empty without one.
-std::vector<double> ratio_samples(const RowIndex& index, const Row& row) {
-  if (is_reference(row)) return {};
+// A row's ratio samples to the reference row measured beside it in the same
+// run (same scene, ray set, threads): in a file timed in rounds, sample i over
+// the reference's sample i (read_reference checked the counts); otherwise
+// each sample over the reference's median. Empty without a reference row.
+std::vector<double> ratio_samples(const ResultsFile& f, const RowIndex& index, const Row& row) {
+  if (is_reference(row, f)) return {};
   const Row* e = index.reference_beside(row);
   if (!e) return {};
-  const double reference = median(parse_samples(e->at("mrays_s_samples")));
-  if (!(reference > 0)) return {};
+  const std::vector<double> reference = parse_samples(e->at("mrays_s_samples"));
   std::vector<double> out = parse_samples(row.at("mrays_s_samples"));
-  for (double& v : out) v /= reference;
+  if (f.paired && reference.size() == out.size()) {
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] /= reference[i];
+    return out;
+  }
+  const double m = median(reference);
+  if (!(m > 0)) return {};
+  for (double& v : out) v /= m;
   return out;
 }
 
 std::string percent(double change) { return fmt::format("{:+.1f}%", 100.0 * change); }
+
+}  // namespace
 
 // A JSON string literal (RFC 8259: quote, backslash and control characters escaped).
 std::string json_string(const std::string& s) {
@@ -188,9 +244,8 @@ std::string json_string(const std::string& s) {
   return out + "\"";
 }
 
-std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "null"; }
-
-}  // namespace
+// The shortest text that reads back as the same double.
+std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{}", v) : "null"; }
 
 ResultsFile read_results_file(const std::string& path) {
   ResultsFile f;
@@ -228,6 +283,7 @@ ResultsFile read_results_file(const std::string& path) {
       throw InputError(meta, fmt::format("'status': '{}', expected \"partial\" or \"complete\"", status->second));
     }
   }
+  read_reference(f);
   return f;
 }
 
@@ -242,9 +298,16 @@ std::vector<std::string> partial_notes(const ResultsFile& f) {
 
 ResultsFile pool_runs(const std::vector<ResultsFile>& runs) {
   if (runs.empty()) throw InputError("", "no results to pool");
-  for (const ResultsFile& run : runs) require_reference_rows(run);
+  for (const ResultsFile& run : runs) {
+    if (run.reference != runs.front().reference)
+      throw InputError(run.path, fmt::format("its ratios are to '{}', those of {} to '{}': runs pooled as one baseline "
+                                             "need one reference",
+                                             run.reference, runs.front().path, runs.front().reference));
+    require_reference_rows(run);
+  }
   ResultsFile pooled = runs.front();
   if (runs.size() == 1) return pooled;
+  pooled.paired = false;  // the pairs are kept in the rescaled samples (pool_runs in compare.h)
   std::vector<RowIndex> indexes;
   indexes.reserve(runs.size());
   for (const ResultsFile& run : runs) indexes.emplace_back(run);
@@ -253,23 +316,29 @@ ResultsFile pool_runs(const std::vector<ResultsFile>& runs) {
     pooled.partial.insert(pooled.partial.end(), runs[i].partial.begin(), runs[i].partial.end());
   }
   for (auto& row : pooled.rows) {
-    // Every run's own Embree median for this row, and the pooled one.
-    std::vector<double> reference_per_run, all_reference;
+    // Every run's own reference samples for this row, and the pooled median.
+    std::vector<std::vector<double>> reference_per_run;
+    std::vector<double> all_reference;
     for (const RowIndex& index : indexes) {
       const Row* e = index.reference_beside(row);
-      const std::vector<double> s = e ? parse_samples(e->at("mrays_s_samples")) : std::vector<double>{};
-      reference_per_run.push_back(s.empty() ? 0.0 : median(s));
-      all_reference.insert(all_reference.end(), s.begin(), s.end());
+      reference_per_run.push_back(e ? parse_samples(e->at("mrays_s_samples")) : std::vector<double>{});
+      all_reference.insert(all_reference.end(), reference_per_run.back().begin(), reference_per_run.back().end());
     }
     const double pooled_reference = all_reference.empty() ? 0.0 : median(all_reference);
     std::string samples;
     for (std::size_t i = 0; i < runs.size(); ++i) {
       const Row* r = indexes[i].find(row);
       if (!r) continue;
-      const bool rescale = !is_reference(row) && reference_per_run[i] > 0 && pooled_reference > 0;
-      for (double v : parse_samples(r->at("mrays_s_samples")))
+      const std::vector<double> own = parse_samples(r->at("mrays_s_samples"));
+      const std::vector<double>& reference = reference_per_run[i];
+      const bool rescale = !is_reference(row, pooled) && !reference.empty() && pooled_reference > 0;
+      const bool pairs = runs[i].paired && reference.size() == own.size();
+      const double run_median = reference.empty() ? 0.0 : median(reference);
+      for (std::size_t k = 0; k < own.size(); ++k) {
+        const double divisor = pairs ? reference[k] : run_median;
         samples += fmt::format("{}{:.9g}", samples.empty() ? "" : ";",
-                               rescale ? v * pooled_reference / reference_per_run[i] : v);
+                               rescale && divisor > 0 ? own[k] * pooled_reference / divisor : own[k]);
+      }
     }
     row["mrays_s_samples"] = samples;
   }
@@ -307,6 +376,10 @@ std::string to_string(Verdict v) {
 }
 
 Comparison compare_results(const ResultsFile& base, const ResultsFile& current, const CompareOptions& options) {
+  if (base.reference != current.reference)
+    throw InputError(current.path, fmt::format("its ratios are to '{}' (reference_backend), those of {} to '{}': runs "
+                                               "measured against different references do not compare",
+                                               current.reference, base.path, base.reference));
   Comparison c;
   const RowIndex base_index(base), current_index(current);
   for (const auto& b : base.rows) {
@@ -325,7 +398,7 @@ Comparison compare_results(const ResultsFile& base, const ResultsFile& current, 
     rc.same_rays = b.at("rays") == n->at("rays");
     if (rc.same_rays) {
       rc.throughput = compare_samples(parse_samples(b.at("mrays_s_samples")), parse_samples(n->at("mrays_s_samples")), options);
-      rc.ratio = compare_samples(ratio_samples(base_index, b), ratio_samples(current_index, *n), options);
+      rc.ratio = compare_samples(ratio_samples(base, base_index, b), ratio_samples(current, current_index, *n), options);
       for (const std::string& col : deterministic_columns())
         if (b.at(col) != n->at(col)) rc.changes.push_back({col, b.at(col), n->at(col)});
     }
@@ -356,7 +429,8 @@ std::string format_comparison(const Comparison& c, const ResultsFile& base, cons
   };
   std::string out;
   if (format == OutputFormat::kJson) {
-    out += "{\n  \"base\": " + json_string(base.path) + ",\n  \"current\": " + json_string(current.path) + ",\n  \"rows\": [\n";
+    out += "{\n  \"base\": " + json_string(base.path) + ",\n  \"current\": " + json_string(current.path) +
+           ",\n  \"reference_backend\": " + json_string(current.reference) + ",\n  \"rows\": [\n";
     for (std::size_t i = 0; i < c.rows.size(); ++i) {
       const RowComparison& r = c.rows[i];
       std::string changes;
@@ -372,14 +446,16 @@ std::string format_comparison(const Comparison& c, const ResultsFile& base, cons
                            json_string(to_string(s.verdict)));
       };
       // The reference backend's own ratio is 1 by definition, as the CSV says (see compare.h).
-      const bool reference = r.backend == kReferenceBackend;
+      const bool reference = r.backend == current.reference;
       const std::string ratio =
           reference ? R"({"base": 1, "current": 1, "change": 0, "p_value": null, "verdict": "reference"})" : sample(r.ratio);
+      // ratio_to_embree, as before --reference: the same comparison when Embree is the reference.
+      const std::string to_embree = current.reference == "embree" ? ratio : sample(SampleComparison{});
       out += fmt::format(
           "    {{\"scene\": {}, \"rayset\": {}, \"backend\": {}, \"threads\": {}, \"reference\": {}, "
-          "\"same_rays\": {}, \"mrays_s\": {}, \"ratio_to_embree\": {}, \"changes\": [{}]}}{}\n",
+          "\"same_rays\": {}, \"mrays_s\": {}, \"ratio_to_reference\": {}, \"ratio_to_embree\": {}, \"changes\": [{}]}}{}\n",
           json_string(r.scene), json_string(r.rayset), json_string(r.backend), r.threads, reference ? "true" : "false",
-          r.same_rays ? "true" : "false", sample(r.throughput), ratio, changes, i + 1 < c.rows.size() ? "," : "");
+          r.same_rays ? "true" : "false", sample(r.throughput), ratio, to_embree, changes, i + 1 < c.rows.size() ? "," : "");
     }
     const auto list = [&](const std::vector<std::string>& v) {
       std::string s;
@@ -392,7 +468,7 @@ std::string format_comparison(const Comparison& c, const ResultsFile& base, cons
   }
   const bool md = format == OutputFormat::kMarkdown;
   std::vector<std::vector<std::string>> table;
-  table.push_back({"scene", "rayset", "backend", "thr", "Mrays/s base", "current", "change", "p", "verdict", "x embree",
+  table.push_back({"scene", "rayset", "backend", "thr", "Mrays/s base", "current", "change", "p", "verdict", "x " + current.reference,
                    "change", "p", "verdict", "deterministic changes"});
   std::vector<std::vector<Verdict>> verdicts;
   for (const RowComparison& r : c.rows) {
@@ -477,15 +553,38 @@ GateConfig load_gate_config(const std::string& path) {
   return g;
 }
 
+namespace {
+
+// A failure of the row `r` (of the gated run), its message prefixed with the row.
+GateFailure failure_of(const Row& r, std::string check, std::string message) {
+  GateFailure f;
+  f.scene = r.at("scene");
+  f.rayset = r.at("rayset");
+  f.backend = r.at("backend");
+  f.threads = r.at("threads");
+  f.check = std::move(check);
+  f.message = row_key(r) + ": " + message;
+  return f;
+}
+
+// A numeric column of a row; NaN when empty ("not applicable").
+// read_results_file checked the values.
+double number_of(const Row& r, const char* column) { return parse_number(r.at(column)).value_or(std::nan("")); }
+
+}  // namespace
+
 GateResult run_gate(const ResultsFile& baseline, const std::vector<ResultsFile>& currents, const GateConfig& config) {
   GateResult g;
+  g.mode = "runs";
+  g.reference = baseline.reference;
   require_reference_rows(baseline);
+  const std::string& ref = baseline.reference;
   CompareOptions o;
   o.alpha = config.alpha;
   o.min_effect = config.max_ratio_drop;
   const ResultsFile& current = currents.at(0);
   const Comparison c = compare_results(baseline, current, o);
-  // Rows whose ratio to Embree fell significantly in every other run too.
+  // Rows whose ratio to the reference fell significantly in every other run too.
   struct Confirmation {
     Comparison comparison;
     std::unordered_map<std::string, std::size_t> by_key;  // match_key -> index in comparison.rows
@@ -507,69 +606,278 @@ GateResult run_gate(const ResultsFile& baseline, const std::vector<ResultsFile>&
   for (const ResultsFile& run : currents)
     for (const std::string& n : partial_notes(run)) g.notes.push_back(n);
   for (const std::string& d : machine_differences(baseline, current))
-    g.notes.push_back("machine differs (" + d + "): gating on ratios to Embree and deterministic columns only");
+    g.notes.push_back("machine differs (" + d + "): gating on ratios to " + ref + " and deterministic columns only");
+  const RowIndex current_index(current);
   if (config.fail_on_missing_rows)
-    for (const std::string& k : c.only_in_base) g.failures.push_back(k + ": in the baseline but not in the current run");
-  // A baseline row measured in a current run without its Embree row: its
-  // ratio to Embree, what the gate checks, cannot be computed there.
+    for (const Row& b : baseline.rows)
+      if (!current_index.find(b)) g.failures.push_back(failure_of(b, "missing", "in the baseline but not in the current run"));
+  // A baseline row measured in a current run without its reference row: its
+  // ratio, what the gate checks, cannot be computed there.
   for (const ResultsFile& run : currents) {
     const RowIndex index(run);
     for (const Row& b : baseline.rows)
-      if (!is_reference(b) && index.find(b) && !index.reference_beside(b))
-        g.failures.push_back(fmt::format("{}: no embree row for {}/{}/threads:{} in {}: its ratio to Embree cannot be checked",
-                                         row_key(b), b.at("scene"), b.at("rayset"), b.at("threads"), run.path));
+      if (!is_reference(b, baseline) && index.find(b) && !index.reference_beside(b))
+        g.failures.push_back(failure_of(b, "missing",
+                                        fmt::format("no {} row for {}/{}/threads:{} in {}: its ratio to {} cannot be checked",
+                                                    ref, b.at("scene"), b.at("rayset"), b.at("threads"), run.path, ref)));
   }
-  // A numeric column of the baseline's (from_base) or the current run's row;
-  // NaN when empty ("not applicable"). read_results_file checked the values.
-  const auto number_in = [&](const RowComparison& rc, bool from_base, const char* col) {
-    return parse_number((from_base ? rc.base_row : rc.current_row)->at(col)).value_or(std::nan(""));
-  };
   for (const RowComparison& r : c.rows) {
-    const std::string key = row_key(*r.base_row);
+    const Row& base = *r.base_row;
+    const Row& now = *r.current_row;
     if (!r.same_rays) {
-      g.failures.push_back(key + ": ray count differs from the baseline (" + r.base_row->at("rays") + " vs " +
-                           r.current_row->at("rays") + "); regenerate the baseline");
+      GateFailure f = failure_of(base, "rays", "ray count differs from the baseline (" + base.at("rays") + " vs " +
+                                                   now.at("rays") + "); regenerate the baseline");
+      f.value = number_of(now, "rays");
+      f.against = number_of(base, "rays");
+      g.failures.push_back(f);
       continue;
     }
     std::string also;
-    if (r.ratio.verdict == Verdict::kSlower && confirmed(r, also))
-      g.failures.push_back(fmt::format("{}: ratio to Embree fell {:.1f}% ({:.3f} -> {:.3f}, p = {:.2g}{}; limit {:.0f}%)", key,
-                                       -100.0 * r.ratio.change, r.ratio.base, r.ratio.current, r.ratio.p_value, also,
-                                       100.0 * config.max_ratio_drop));
-    else if (r.ratio.verdict == Verdict::kSlower)
-      g.notes.push_back(fmt::format("{}: ratio to Embree fell {:.1f}% in one run but not in the confirming run: noise",
-                                    key, -100.0 * r.ratio.change));
-    else if (r.ratio.verdict == Verdict::kUnsure && r.ratio.change < 0)
-      g.notes.push_back(fmt::format("{}: ratio to Embree {:+.1f}% but not significant (p = {:.2g})", key,
+    const std::string key = row_key(base);
+    if (r.ratio.verdict == Verdict::kSlower && confirmed(r, also)) {
+      GateFailure f = failure_of(base, "speed",
+                                 fmt::format("ratio to {} fell {:.1f}% ({:.3f} -> {:.3f}, p = {:.2g}{}; limit {:.0f}%)", ref,
+                                             -100.0 * r.ratio.change, r.ratio.base, r.ratio.current, r.ratio.p_value, also,
+                                             100.0 * config.max_ratio_drop));
+      f.value = r.ratio.current;
+      f.against = r.ratio.base;
+      f.change = r.ratio.change;
+      f.p_value = r.ratio.p_value;
+      f.limit = config.max_ratio_drop;
+      g.failures.push_back(f);
+    } else if (r.ratio.verdict == Verdict::kSlower) {
+      g.notes.push_back(fmt::format("{}: ratio to {} fell {:.1f}% in one run but not in the confirming run: noise", key,
+                                    ref, -100.0 * r.ratio.change));
+    } else if (r.ratio.verdict == Verdict::kUnsure && r.ratio.change < 0) {
+      g.notes.push_back(fmt::format("{}: ratio to {} {:+.1f}% but not significant (p = {:.2g})", key, ref,
                                     100.0 * r.ratio.change, r.ratio.p_value));
+    }
     // A value the baseline recorded and the current run does not (only an
     // occluded row may leave agree_prim empty, so the query changed).
     for (const char* col : {"agree_hit", "agree_prim", "leaks"})
-      if (!std::isnan(number_in(r, true, col)) && std::isnan(number_in(r, false, col)))
-        g.failures.push_back(fmt::format("{}: {} is empty in the current run (baseline {})", key, col, r.base_row->at(col)));
-    const double hit_drop = number_in(r, true, "agree_hit") - number_in(r, false, "agree_hit");
-    if (hit_drop > config.max_agree_hit_drop)
-      g.failures.push_back(fmt::format("{}: agree_hit fell by {:.6f} ({} -> {}; limit {})", key, hit_drop,
-                                       r.base_row->at("agree_hit"), r.current_row->at("agree_hit"), config.max_agree_hit_drop));
-    const double prim_drop = number_in(r, true, "agree_prim") - number_in(r, false, "agree_prim");
-    if (prim_drop > config.max_agree_prim_drop)
-      g.failures.push_back(fmt::format("{}: agree_prim fell by {:.6f} ({} -> {}; limit {})", key, prim_drop,
-                                       r.base_row->at("agree_prim"), r.current_row->at("agree_prim"), config.max_agree_prim_drop));
+      if (!std::isnan(number_of(base, col)) && std::isnan(number_of(now, col))) {
+        GateFailure f = failure_of(base, col, fmt::format("{} is empty in the current run (baseline {})", col, base.at(col)));
+        f.against = number_of(base, col);
+        g.failures.push_back(f);
+      }
+    for (const auto& [col, limit] : {std::pair<const char*, double>{"agree_hit", config.max_agree_hit_drop},
+                                     std::pair<const char*, double>{"agree_prim", config.max_agree_prim_drop}}) {
+      const double drop = number_of(base, col) - number_of(now, col);
+      if (!(drop > limit)) continue;
+      GateFailure f = failure_of(base, col, fmt::format("{} fell by {:.6f} ({} -> {}; limit {})", col, drop, base.at(col),
+                                                        now.at(col), limit));
+      f.value = number_of(now, col);
+      f.against = number_of(base, col);
+      f.change = -drop;
+      f.limit = limit;
+      g.failures.push_back(f);
+    }
     const bool seed_faithful = r.backend.find("_seed") != std::string::npos;
-    const double agree_hit = number_in(r, false, "agree_hit");
-    const bool must_hit = !r.current_row->at("leaks").empty();
-    if (!seed_faithful && !must_hit && agree_hit < config.min_agree_hit)
-      g.failures.push_back(fmt::format("{}: agree_hit {} is below the floor {}", key, r.current_row->at("agree_hit"),
-                                       config.min_agree_hit));
+    const double agree_hit = number_of(now, "agree_hit");
+    const bool must_hit = !now.at("leaks").empty();
+    if (!seed_faithful && !must_hit && agree_hit < config.min_agree_hit) {
+      GateFailure f = failure_of(base, "agree_hit",
+                                 fmt::format("agree_hit {} is below the floor {}", now.at("agree_hit"), config.min_agree_hit));
+      f.value = agree_hit;
+      f.limit = config.min_agree_hit;
+      g.failures.push_back(f);
+    }
     for (const std::string& pattern : config.no_new_leaks) {
       if (r.backend.find(pattern) == std::string::npos || !must_hit) continue;
-      const double before = number_in(r, true, "leaks"), after = number_in(r, false, "leaks");
-      if (after > (std::isnan(before) ? 0.0 : before))
-        g.failures.push_back(fmt::format("{}: new leaks: {} rays miss a closed mesh from inside (baseline {})", key,
-                                         r.current_row->at("leaks"), r.base_row->at("leaks").empty() ? "-" : r.base_row->at("leaks")));
+      const double before = number_of(base, "leaks"), after = number_of(now, "leaks");
+      if (after > (std::isnan(before) ? 0.0 : before)) {
+        GateFailure f = failure_of(base, "leaks",
+                                   fmt::format("new leaks: {} rays miss a closed mesh from inside (baseline {})",
+                                               now.at("leaks"), base.at("leaks").empty() ? "-" : base.at("leaks")));
+        f.value = after;
+        f.against = std::isnan(before) ? 0.0 : before;
+        g.failures.push_back(f);
+        break;
+      }
     }
   }
   return g;
+}
+
+GateResult run_within_run_gate(const ResultsFile& run, const std::vector<std::string>& candidates,
+                               const GateConfig& config) {
+  GateResult g;
+  g.mode = "within-run";
+  g.reference = run.reference;
+  const std::string& ref = run.reference;
+  if (!run.paired)
+    throw InputError(run.path, fmt::format("its samples are not paired by round (no timing = \"rounds\" in {}): the "
+                                           "gate within one run needs them; re-run with this raybench",
+                                           metadata_path_for(run.path)));
+  if (candidates.empty()) throw InputError("--candidate", "name at least one backend of the run to gate");
+  std::vector<std::string> backends;  // in the run's order
+  for (const Row& r : run.rows)
+    if (std::find(backends.begin(), backends.end(), r.at("backend")) == backends.end()) backends.push_back(r.at("backend"));
+  for (const std::string& c : candidates) {
+    if (c == ref)
+      throw InputError("--candidate", fmt::format("'{}' is the run's reference (reference_backend): name another of "
+                                                  "its backends ({})", c, fmt::join(backends, ", ")));
+    if (std::find(backends.begin(), backends.end(), c) == backends.end())
+      throw InputError("--candidate", fmt::format("'{}' is not a backend of {}; it has {}", c, run.path,
+                                                  fmt::join(backends, ", ")));
+  }
+  // A run that stopped early (a candidate that crashed the process, say)
+  // lacks the rows of its unfinished scenes: nothing here can pass them.
+  for (const std::string& n : partial_notes(run)) {
+    GateFailure f;
+    f.check = "missing";
+    f.message = n;
+    g.failures.push_back(f);
+  }
+  const RowIndex index(run);
+  // Every (scene, rayset, threads) of the run, in its order, by a row there.
+  std::vector<const Row*> places;
+  std::set<std::string> seen;
+  for (const Row& r : run.rows)
+    if (seen.insert(key_beside(r, "")).second) places.push_back(&r);
+  const std::size_t min_rounds = signed_rank_min_pairs(config.alpha);
+  std::size_t untestable = 0, fewest_rounds = std::numeric_limits<std::size_t>::max();
+  std::set<std::string> done;
+  for (const std::string& candidate : candidates) {
+    if (!done.insert(candidate).second) continue;  // named twice
+    for (const Row* place : places) {
+      const Row* cand = index.beside(*place, candidate);
+      const Row* reference = index.reference_beside(*place);
+      if (!cand || !reference) {
+        Row named = *place;
+        named["backend"] = candidate;
+        const std::string what = !cand && !reference ? fmt::format("neither {} nor the reference {} has a row", candidate, ref)
+                                 : !cand           ? fmt::format("no {} row in {}", candidate, run.path)
+                                                   : fmt::format("no row of the reference {} in {}", ref, run.path);
+        if (config.fail_on_missing_rows) g.failures.push_back(failure_of(named, "missing", what));
+        else g.notes.push_back(row_key(named) + ": " + what);
+        continue;
+      }
+      if (cand->at("rays") != reference->at("rays")) {
+        GateFailure f = failure_of(*cand, "rays", fmt::format("traced {} rays, the reference {} {}", cand->at("rays"), ref,
+                                                              reference->at("rays")));
+        f.value = number_of(*cand, "rays");
+        f.against = number_of(*reference, "rays");
+        g.failures.push_back(f);
+        continue;
+      }
+      // Speed: the rounds' paired ratios (read_reference checked the counts).
+      const std::vector<double> ratios = ratio_samples(run, index, *cand);
+      std::vector<double> logs;
+      for (double v : ratios) logs.push_back(std::log(v));
+      const double m = median(ratios);
+      const SignedRank test = signed_rank_less(logs);
+      g.speeds.push_back({cand->at("scene"), cand->at("rayset"), candidate, cand->at("threads"), ratios.size(), m,
+                          *std::min_element(ratios.begin(), ratios.end()), *std::max_element(ratios.begin(), ratios.end()),
+                          test.p_value});
+      const bool testable = ratios.size() >= min_rounds;
+      if (!testable) {
+        ++untestable;
+        fewest_rounds = std::min(fewest_rounds, ratios.size());
+      }
+      if (m < 1.0 - config.max_ratio_drop) {
+        if (test.p_value < config.alpha) {
+          GateFailure f = failure_of(*cand, "speed",
+                                     fmt::format("{:.1f}% slower than the reference {} (paired ratio {:.3f} over {} rounds, "
+                                                 "p = {:.2g}; limit {:.0f}%)",
+                                                 100.0 * (1.0 - m), ref, m, ratios.size(), test.p_value,
+                                                 100.0 * config.max_ratio_drop));
+          f.value = m;
+          f.against = 1.0;
+          f.change = m - 1.0;
+          f.p_value = test.p_value;
+          f.limit = config.max_ratio_drop;
+          g.failures.push_back(f);
+        } else if (!testable) {
+          g.notes.push_back(fmt::format("{}: {:.1f}% slower than the reference {} (paired ratio {:.3f}), but {} rounds can "
+                                        "never give p < {}: re-run with --reps {} or more to gate its speed",
+                                        row_key(*cand), 100.0 * (1.0 - m), ref, m, ratios.size(), config.alpha, min_rounds));
+        } else {
+          g.notes.push_back(fmt::format("{}: {:.1f}% slower than the reference {} but not significant (p = {:.2g})",
+                                        row_key(*cand), 100.0 * (1.0 - m), ref, test.p_value));
+        }
+      }
+      // Agreement with Embree and leaks: no worse than the reference's.
+      for (const char* col : {"agree_hit", "agree_prim", "leaks"})
+        if (!std::isnan(number_of(*reference, col)) && std::isnan(number_of(*cand, col))) {
+          GateFailure f = failure_of(*cand, col, fmt::format("{} is empty, the reference {} has {}", col, ref,
+                                                             reference->at(col)));
+          f.against = number_of(*reference, col);
+          g.failures.push_back(f);
+        }
+      for (const auto& [col, limit] : {std::pair<const char*, double>{"agree_hit", config.max_agree_hit_drop},
+                                       std::pair<const char*, double>{"agree_prim", config.max_agree_prim_drop}}) {
+        const double drop = number_of(*reference, col) - number_of(*cand, col);
+        if (!(drop > limit)) continue;
+        GateFailure f = failure_of(*cand, col, fmt::format("{} {} is {:.6f} below the reference {}'s {} (limit {})", col,
+                                                           cand->at(col), drop, ref, reference->at(col), limit));
+        f.value = number_of(*cand, col);
+        f.against = number_of(*reference, col);
+        f.change = -drop;
+        f.limit = limit;
+        g.failures.push_back(f);
+      }
+      const double leaks = number_of(*cand, "leaks"), reference_leaks = number_of(*reference, "leaks");
+      if (leaks > reference_leaks) {
+        GateFailure f = failure_of(*cand, "leaks",
+                                   fmt::format("{} rays miss a closed mesh from inside, the reference {} {}",
+                                               cand->at("leaks"), ref, reference->at("leaks")));
+        f.value = leaks;
+        f.against = reference_leaks;
+        g.failures.push_back(f);
+      }
+    }
+  }
+  if (untestable > 0)
+    g.notes.push_back(fmt::format("{} row{} had {} rounds or fewer: the signed-rank test needs {} to ever reach p < {}, so "
+                                  "their speed is not gated (run with --reps {} or more)",
+                                  untestable, untestable == 1 ? "" : "s", fewest_rounds, min_rounds, config.alpha, min_rounds));
+  return g;
+}
+
+std::string format_paired_speeds(const GateResult& g) {
+  std::vector<std::vector<std::string>> table = {
+      {"scene", "rayset", "backend", "thr", "rounds", "x " + g.reference, "[min - max]", "p (slower)"}};
+  for (const PairedSpeed& s : g.speeds)
+    table.push_back({s.scene, s.rayset, s.backend, s.threads, std::to_string(s.rounds), fmt::format("{:.3f}", s.ratio),
+                     fmt::format("[{:.3f} - {:.3f}]", s.ratio_min, s.ratio_max), fmt::format("{:.2g}", s.p_value)});
+  std::vector<std::size_t> width(table[0].size(), 0);
+  for (const auto& row : table)
+    for (std::size_t i = 0; i < row.size(); ++i) width[i] = std::max(width[i], row[i].size());
+  std::string out;
+  for (const auto& row : table) {
+    std::string line;
+    for (std::size_t i = 0; i < row.size(); ++i) line += fmt::format("{:<{}}", row[i], width[i]) + "  ";
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    out += line + "\n";
+  }
+  return out;
+}
+
+std::string format_gate_json(const GateResult& g, const std::vector<std::string>& currents,
+                             const std::vector<std::string>& baselines, const std::vector<std::string>& candidates) {
+  const auto list = [](const std::vector<std::string>& v) {
+    std::string s;
+    for (const auto& e : v) s += (s.empty() ? "" : ", ") + json_string(e);
+    return "[" + s + "]";
+  };
+  std::string out = fmt::format("{{\n  \"verdict\": {},\n  \"mode\": {},\n  \"reference\": {},\n  \"current\": {},\n"
+                                "  \"baseline\": {},\n  \"candidates\": {},\n  \"failures\": [",
+                                json_string(g.failures.empty() ? "pass" : "fail"), json_string(g.mode),
+                                json_string(g.reference), list(currents), list(baselines), list(candidates));
+  for (std::size_t i = 0; i < g.failures.size(); ++i) {
+    const GateFailure& f = g.failures[i];
+    const std::optional<double> threads = parse_number(f.threads);
+    out += fmt::format(
+        "{}\n    {{\"scene\": {}, \"rayset\": {}, \"backend\": {}, \"threads\": {}, \"check\": {}, \"kind\": {}, "
+        "\"message\": {}, \"value\": {}, \"against\": {}, \"change\": {}, \"p_value\": {}, \"limit\": {}}}",
+        i ? "," : "", json_string(f.scene), json_string(f.rayset), json_string(f.backend),
+        threads ? json_number(*threads) : "null", json_string(f.check), f.kind.empty() ? "null" : json_string(f.kind),
+        json_string(f.message), json_number(f.value), json_number(f.against), json_number(f.change),
+        json_number(f.p_value), json_number(f.limit));
+  }
+  out += std::string(g.failures.empty() ? "" : "\n  ") + "],\n  \"notes\": " + list(g.notes) + "\n}\n";
+  return out;
 }
 
 }  // namespace raybench

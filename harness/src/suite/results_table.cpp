@@ -18,14 +18,23 @@ std::string camera_warning(const CameraCoverage& c) {
                      100.0 * c.hit_fraction, c.preview);
 }
 
+std::string backend_label(const ResultRow& row) {
+  return row.plugin.empty() ? row.backend : fmt::format("{} ({})", row.plugin, row.backend);
+}
+
 std::string format_results_table(const std::vector<ResultRow>& rows, const std::vector<CameraCoverage>& cameras) {
-  // Column widths follow the longest ray-set and backend names in the run;
-  // with the default suite's names a line stays within 120 columns.
-  std::size_t rayset_width = 6, backend_width = 7;
+  // Column widths follow the longest ray-set and backend names in the run
+  // and the timing reference's name; with the default suite's names a line
+  // stays within 120 columns.
+  std::size_t rayset_width = 6, backend_width = 7, ratio_width = 8;
+  std::string reference;  // one per run: every row names the same
   for (const ResultRow& r : rows) {
     rayset_width = std::max(rayset_width, r.rayset.size());
-    backend_width = std::max(backend_width, r.backend.size());
+    backend_width = std::max(backend_width, backend_label(r).size());
+    if (reference.empty()) reference = r.reference;
   }
+  const std::string ratio_header = reference.empty() ? "x ref" : "x " + reference;
+  ratio_width = std::max(ratio_width, ratio_header.size());
   const auto percent = [](double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.3f}%", 100.0 * v); };
   std::string out, scene;
   bool any_spread = false;
@@ -35,23 +44,23 @@ std::string format_results_table(const std::vector<ResultRow>& rows, const std::
       out += fmt::format("\n{} ({} triangles)\n", r.scene, r.triangles);
       for (const CameraCoverage& c : cameras)
         if (c.scene == scene && sees_little(c)) out += "  warning: " + camera_warning(c) + "\n";
-      out += fmt::format("  {:<{}} {:<{}} {:>3} {:>8} {:>18} {:>8} {:>7} {:>8} {:>8} {:>8} {:>7} {:>6}\n", "rayset",
-                         rayset_width, "backend", backend_width, "thr", "Mrays/s", "[min - max] ", "x embree", "hit",
-                         "agree", "same tri", "build ms", "MiB", "leaks");
+      out += fmt::format("  {:<{}} {:<{}} {:>3} {:>8} {:>18} {:>{}} {:>7} {:>8} {:>8} {:>8} {:>7} {:>6}\n", "rayset",
+                         rayset_width, "backend", backend_width, "thr", "Mrays/s", "[min - max] ", ratio_header,
+                         ratio_width, "hit", "agree", "same tri", "build ms", "MiB", "leaks");
     }
     const bool spread = spreads_widely(r);
     any_spread = any_spread || spread;
-    out += fmt::format("  {:<{}} {:<{}} {:>3} {:>8.2f} {:>18} {:>8} {:>7} {:>8} {:>8} {:>8.1f} {:>7.1f} {:>6}\n", r.rayset,
-                       rayset_width, r.backend, backend_width, r.threads, r.mrays_s,
+    out += fmt::format("  {:<{}} {:<{}} {:>3} {:>8.2f} {:>18} {:>{}} {:>7} {:>8} {:>8} {:>8.1f} {:>7.1f} {:>6}\n", r.rayset,
+                       rayset_width, backend_label(r), backend_width, r.threads, r.mrays_s,
                        fmt::format("[{:.2f} - {:.2f}]{}", r.mrays_s_min, r.mrays_s_max, spread ? "!" : " "),
-                       r.ratio_to_embree > 0 ? fmt::format("{:.2f}", r.ratio_to_embree) : "-",
+                       r.ratio_to_reference > 0 ? fmt::format("{:.2f}", r.ratio_to_reference) : "-", ratio_width,
                        fmt::format("{:.1f}%", 100.0 * r.hit_rate), percent(r.agree_hit), percent(r.agree_prim), r.build_ms,
                        r.memory_bytes / 1048576.0, r.leaks ? std::to_string(*r.leaks) : "-");
   }
   if (any_spread)
-    out += fmt::format("\n! repetitions spread widely (fastest / slowest > {}): that median and its x embree are not to be "
+    out += fmt::format("\n! repetitions spread widely (fastest / slowest > {}): that median and its {} are not to be "
                        "trusted;\n  rerun on a quiet machine, with more --reps or a longer --min-time\n",
-                       kMaxRepetitionSpread);
+                       kMaxRepetitionSpread, ratio_header);
   return out;
 }
 

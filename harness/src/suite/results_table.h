@@ -1,7 +1,8 @@
-// The tables a run prints at its end: per scene, speed and agreement with
-// Embree (every run), then the exact referee's verdicts (--accuracy runs),
-// with the two warnings a newcomer would otherwise miss: a case whose
-// repetitions spread widely, and a camera that sees little of its scene.
+// The tables a run prints at its end: per scene, speed relative to the run's
+// timing reference and agreement with Embree (every run), then the exact
+// referee's verdicts (--accuracy runs), with the two warnings a newcomer
+// would otherwise miss: a case whose repetitions spread widely, and a camera
+// that sees little of its scene.
 #pragma once
 
 #include <string>
@@ -33,7 +34,13 @@ bool sees_little(const CameraCoverage& c);
 // "camera sees little of the scene: 8.7 % of primary rays hit; check it with scripts/preview_camera ..."
 std::string camera_warning(const CameraCoverage& c);
 
-// The aligned per-scene table of speed and agreement. A row whose
+// How a table names a row's backend: its name, or for a plugin the name the
+// plugin reports and the backend as given: "my_bvh (plugin:build/libmy.so)".
+std::string backend_label(const ResultRow& row);
+
+// The aligned per-scene table of speed and agreement, with each row's speed
+// relative to the run's timing reference ("x NAME", ratio_to_reference;
+// "x ref" and "-" in a run without one). A row whose
 // repetitions spread widely carries '!' after its [min - max], explained
 // under the table; a scene in `cameras` that sees little gets a warning line.
 std::string format_results_table(const std::vector<ResultRow>& rows, const std::vector<CameraCoverage>& cameras = {});

@@ -105,6 +105,16 @@ double alpha_setting(const GivenValue& v) { return number_in(v, 0.0, true, 1.0, 
 
 double min_effect_setting(const GivenValue& v) { return number_in(v, 0.0, false, 10.0, false, "a relative change"); }
 
+std::string reference_setting(const GivenValue& v) {
+  const std::string rule = "one of the run's backend names, e.g. embree";
+  if (v.text.empty()) refuse(v, rule);
+  for (const char c : v.text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f || c == ',') refuse(v, rule + " (one name, no ',' or control character)");
+  }
+  return v.text;
+}
+
 std::string scene_name_problem(std::string_view name) {
   if (name.empty()) return "a scene name must not be empty";
   for (const char c : name) {

@@ -52,6 +52,10 @@ double min_time_setting(const GivenValue& v);           // finite seconds in (0,
 double warmup_setting(const GivenValue& v);             // finite seconds in [0, kMaxSeconds]
 double alpha_setting(const GivenValue& v);              // finite, in (0, 1)
 double min_effect_setting(const GivenValue& v);         // finite, in [0, 10]
+// The timing reference (--reference, [defaults] reference): a backend name as
+// --backend takes it (not empty, no ',' or control character). Whether the
+// run has that backend is checked when the run starts (timing_reference).
+std::string reference_setting(const GivenValue& v);
 
 // Why `name` cannot name a scene, or "" when it can. A scene's name becomes
 // part of file names in --rays-dir and a field of the results CSV, and is

@@ -258,7 +258,7 @@ Suite load_suite(const std::string& path) {
     const toml::table* t = d->as_table();
     if (!t) r.fail("defaults", "expected a table");
     r.check_keys(*t, "defaults", {"rays", "raysets", "backends", "threads", "repetitions", "build_repetitions", "seed",
-                                  "min_time", "warmup"});
+                                  "min_time", "warmup", "reference"});
     r.setting(*t, "defaults.", "rays", rays_setting, s.rays);
     s.raysets = r.strings(*t, "defaults.", "raysets", s.raysets);
     for (const std::string& k : s.raysets) {
@@ -285,6 +285,12 @@ Suite load_suite(const std::string& path) {
     r.setting(*t, "defaults.", "seed", seed_setting, s.seed);
     r.setting(*t, "defaults.", "min_time", min_time_setting, s.min_time);
     r.setting(*t, "defaults.", "warmup", warmup_setting, s.warmup);
+    if (t->get("reference")) {
+      const GivenValue given = GivenValue::from_manifest(
+          path, "defaults.reference", r.get<std::string>(*t, "defaults.", "reference", ""), std::nullopt, std::nullopt);
+      s.reference = reference_setting(given);
+      s.reference_given = given.where;
+    }
   }
   const fs::path base = fs::path(path).parent_path();
   if (const toml::node* scenes = root.get("scene")) {

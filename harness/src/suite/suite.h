@@ -42,6 +42,12 @@ struct SuiteSettings {
   std::uint64_t seed = 1;
   double min_time = 0.05;  // seconds per repetition (Google Benchmark's min time)
   double warmup = 0.05;    // seconds of untimed warm-up per case
+  // The timing reference (--reference, [defaults] reference): a backend of
+  // the run that ratio_to_reference is relative to; "" for the default
+  // (timing_reference in suite_run.h). reference_given says where it was
+  // given, for messages ("--reference", or "FILE: 'defaults.reference'").
+  std::string reference;
+  std::string reference_given;
 };
 
 struct Suite {

@@ -26,6 +26,7 @@
 #include "results/metadata.h"
 #include "io/npy.h"
 #include "rays/rayset.h"
+#include "rays/screening.h"
 #include "referee/referee.h"
 #include "scene/scene.h"
 #include "suite/results_table.h"
@@ -44,7 +45,8 @@ struct LoadedScene {
 
 struct RaySet {
   RaySetKind kind;
-  std::vector<Ray> rays;
+  std::vector<Ray> rays;               // as stored: what the referee judges
+  ScreenedRays screened;               // what every backend traces (rays/screening.h)
   std::vector<std::int32_t> sources;   // accuracy runs, secondary rays: the triangle each starts from
   std::vector<RefereeVerdict> truth;   // accuracy runs: the referee's verdict per ray
 };
@@ -85,10 +87,21 @@ struct SceneResults {
   std::optional<CameraCoverage> camera;  // runs with the primary ray set
 };
 
-// One scene, scene `index` of `count`: its ray sets (made or reused), the
-// referee's verdicts (accuracy runs), every backend built, agreement with the
-// reference, and the timing of every case. No rows when no ray set applies.
-SceneResults measure_scene(const RunOptions& options, const LoadedScene& loaded, std::size_t index, std::size_t count) {
+// The seed of a scene's round orders: the run's seed and the scene's name,
+// so that every scene is shuffled differently and every run alike.
+std::uint64_t round_seed(std::uint64_t seed, const std::string& scene) {
+  std::uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a
+  for (const char c : scene) h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ull;
+  return h ^ (seed * 0x9e3779b97f4a7c15ull);
+}
+
+// One scene, scene `index` of `count`: its ray sets (made or reused) and
+// screened, the referee's verdicts (accuracy runs), every backend built,
+// agreement with Embree, the timing of every case in rounds, and the ratios
+// to the timing `reference` ("" for none) and to embree. No rows when no ray
+// set applies.
+SceneResults measure_scene(const RunOptions& options, const std::string& reference, const LoadedScene& loaded,
+                           std::size_t index, std::size_t count) {
   const Scene& scene = loaded.scene;
   const SuiteScene* entry = loaded.choice.entry;
   const SuiteSettings& settings = options.settings;
@@ -108,9 +121,13 @@ SceneResults measure_scene(const RunOptions& options, const LoadedScene& loaded,
       }
       RaySetSpec spec{kind, settings.rays, settings.seed, entry ? entry->camera : std::nullopt,
                       entry ? entry->light : std::nullopt, inside};
-      RaySet set{kind, {}, {}, {}};
+      RaySet set{kind, {}, {}, {}, {}};
       const bool want_sources = !options.accuracy_csv.empty() && has_sources(kind);
       set.rays = obtain_rays(generator, scene, spec, options.rays_dir, want_sources ? &set.sources : nullptr);
+      set.screened = screen_rays(set.rays);
+      if (!set.screened.screened.empty() || set.screened.raised_tnear)
+        progress(fmt::format("  {} rays: {} untraceable (misses for every backend), {} with tnear < 0 raised to 0",
+                             name, set.screened.screened.size(), set.screened.raised_tnear));
       raysets.push_back(std::move(set));
     }
   }
@@ -144,21 +161,24 @@ SceneResults measure_scene(const RunOptions& options, const LoadedScene& loaded,
   for (int threads : settings.threads) {
     executors.push_back(std::make_unique<TraceExecutor>(threads));
     const TraceExecutor& executor = *executors.back();
-    // The reference's answers, per ray set, for agreement.
-    std::unique_ptr<Backend> reference = make_backend(kReferenceBackend, {threads});
-    executor.run([&] { reference->build(scene); });
+    // Embree's answers, per ray set, for agreement.
+    std::unique_ptr<Backend> baseline = make_backend(kAgreementBackend, {threads});
+    executor.run([&] { baseline->build(scene); });
     std::vector<std::vector<Hit>> ref_hits(raysets.size());
     std::vector<std::vector<std::uint8_t>> ref_occ(raysets.size());
     for (std::size_t r = 0; r < raysets.size(); ++r) {
+      const ScreenedRays& screened = raysets[r].screened;
       if (query_of(raysets[r].kind) == Query::kIntersect) {
-        ref_hits[r].resize(raysets[r].rays.size());
-        executor.intersect(*reference, raysets[r].rays, ref_hits[r]);
+        ref_hits[r].resize(screened.rays.size());
+        executor.intersect(*baseline, screened.rays, ref_hits[r]);
+        force_misses(screened, ref_hits[r]);
       } else {
-        ref_occ[r].resize(raysets[r].rays.size());
-        executor.occluded(*reference, raysets[r].rays, ref_occ[r]);
+        ref_occ[r].resize(screened.rays.size());
+        executor.occluded(*baseline, screened.rays, ref_occ[r]);
+        force_misses(screened, ref_occ[r]);
       }
     }
-    reference.reset();
+    baseline.reset();
     // What the camera sees, once per scene: Embree's primary hits.
     for (std::size_t r = 0; r < raysets.size() && !results.camera; ++r) {
       if (raysets[r].kind != RaySetKind::kPrimary || ref_hits[r].empty()) continue;
@@ -216,14 +236,18 @@ SceneResults measure_scene(const RunOptions& options, const LoadedScene& loaded,
           accuracy->backend = backend_name;
           accuracy->accuracy_class = backend->accuracy_class();
         }
+        // Untimed: the answers that count, screened rays forced to misses;
+        // the referee judges them against the rays as stored.
         if (query_of(rs.kind) == Query::kIntersect) {
           std::vector<Hit> hits(rs.rays.size());
-          executor.intersect(*backend, rs.rays, hits);
-          a = compare_hits(hits, ref_hits[r], rs.rays, scene.triangles);
+          executor.intersect(*backend, rs.screened.rays, hits);
+          force_misses(rs.screened, hits);
+          a = compare_hits(hits, ref_hits[r], rs.screened.rays, scene.triangles);
           if (accuracy) judge_hits(*referee, rs.rays, rs.truth, hits, rs.sources, *accuracy);
         } else {
           std::vector<std::uint8_t> occ(rs.rays.size());
-          executor.occluded(*backend, rs.rays, occ);
+          executor.occluded(*backend, rs.screened.rays, occ);
+          force_misses(rs.screened, occ);
           a = compare_occlusion(occ, ref_occ[r]);
           if (accuracy) judge_occlusion(rs.rays, rs.truth, occ, *accuracy);
         }
@@ -242,56 +266,72 @@ SceneResults measure_scene(const RunOptions& options, const LoadedScene& loaded,
     }
   }
 
-  // Time every case of this scene in one Google Benchmark run, repetitions
-  // interleaved so that a noisy neighbour hits all backends alike.
-  benchmark::ClearRegisteredBenchmarks();
+  // Time every case of this scene in rounds: round r traces every case once,
+  // in an order shuffled per round (measure/gbench.h, run_rounds), so that
+  // sample r of every row is from the same stretch of time and a noisy
+  // neighbour hits all backends of that round alike.
+  std::vector<RoundCase> round_cases;
   for (const Case& c : cases) {
     const Case* cp = &c;
-    benchmark::RegisterBenchmark(c.name.c_str(),
-                                 [cp](benchmark::State& state) {
-                                   const std::vector<Ray>& rays = cp->rayset->rays;
-                                   std::vector<Hit> hits;
-                                   std::vector<std::uint8_t> occ;
-                                   const bool intersect = query_of(cp->rayset->kind) == Query::kIntersect;
-                                   if (intersect) hits.resize(rays.size());
-                                   else occ.resize(rays.size());
-                                   for (auto _ : state) {
-                                     if (intersect) cp->executor->intersect(*cp->backend, rays, hits);
-                                     else cp->executor->occluded(*cp->backend, rays, occ);
-                                     benchmark::DoNotOptimize(hits.data());
-                                     benchmark::DoNotOptimize(occ.data());
-                                     benchmark::ClobberMemory();
-                                   }
-                                   state.counters["rays"] = benchmark::Counter(static_cast<double>(rays.size()),
-                                                                               benchmark::Counter::kIsIterationInvariantRate);
-                                 })
-        ->Repetitions(settings.repetitions)
-        ->MinTime(settings.min_time)
-        ->MinWarmUpTime(settings.warmup)
-        ->UseRealTime()
-        ->Unit(benchmark::kMillisecond);
+    round_cases.push_back({c.name, [cp](benchmark::State& state) {
+                             const std::vector<Ray>& rays = cp->rayset->screened.rays;
+                             std::vector<Hit> hits;
+                             std::vector<std::uint8_t> occ;
+                             const bool intersect = query_of(cp->rayset->kind) == Query::kIntersect;
+                             if (intersect) hits.resize(rays.size());
+                             else occ.resize(rays.size());
+                             for (auto _ : state) {
+                               if (intersect) cp->executor->intersect(*cp->backend, rays, hits);
+                               else cp->executor->occluded(*cp->backend, rays, occ);
+                               benchmark::DoNotOptimize(hits.data());
+                               benchmark::DoNotOptimize(occ.data());
+                               benchmark::ClobberMemory();
+                             }
+                             state.counters["rays"] = benchmark::Counter(static_cast<double>(rays.size()),
+                                                                         benchmark::Counter::kIsIterationInvariantRate);
+                           }});
   }
-  progress(fmt::format("[{}/{}] {}: timing {} cases x {} repetitions", index + 1, count, scene.name, cases.size(),
-                       settings.repetitions));
-  CollectingReporter reporter("rays", 1e-6, "Mrays/s", cases.size());
-  benchmark::RunSpecifiedBenchmarks(&reporter);
-  benchmark::ClearRegisteredBenchmarks();
-  for (Case& c : cases) {
-    const std::vector<double>& s = reporter.samples(c.name);
-    c.row.mrays_s_samples = s;
-    c.row.reps = static_cast<int>(s.size());
-    c.row.mrays_s = median(s);
-    c.row.mrays_s_min = *std::min_element(s.begin(), s.end());
-    c.row.mrays_s_max = *std::max_element(s.begin(), s.end());
+  progress(fmt::format("[{}/{}] {}: timing {} cases in {} round{}", index + 1, count, scene.name, cases.size(),
+                       settings.repetitions, settings.repetitions == 1 ? "" : "s"));
+  RoundSettings rounds;
+  rounds.rounds = settings.repetitions;
+  rounds.min_time = settings.min_time;
+  rounds.warmup = settings.warmup;
+  rounds.shuffle = options.interleave;
+  rounds.seed = round_seed(settings.seed, scene.name);
+  rounds.counter = "rays";
+  rounds.scale = 1e-6;  // Mrays/s
+  const std::vector<std::vector<double>> samples =
+      run_rounds(round_cases, rounds, [&](int round, double seconds) {
+        progress(fmt::format("  round {}/{} ({} cases) in {:.1f} s", round + 1, settings.repetitions, cases.size(),
+                             seconds));
+      });
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const std::vector<double>& s = samples[i];
+    ResultRow& row = cases[i].row;
+    row.mrays_s_samples = s;  // in round order
+    row.reps = static_cast<int>(s.size());
+    row.mrays_s = median(s);
+    row.mrays_s_min = *std::min_element(s.begin(), s.end());
+    row.mrays_s_max = *std::max_element(s.begin(), s.end());
   }
-  // Ratios to Embree measured in the same run: they survive a change of
-  // machine. The Embree row is in this scene, so they are final here.
+  // Ratios measured in the same run, paired by round (paired_median_ratio):
+  // they survive a change of machine, and noise that hits a whole round
+  // cancels. Both partner rows are in this scene, so the ratios are final here.
+  const auto partner = [&](const Case& c, const std::string& backend) -> const Case* {
+    for (const Case& other : cases)
+      if (other.row.backend == backend && other.row.rayset == c.row.rayset && other.row.threads == c.row.threads)
+        return &other;
+    return nullptr;
+  };
   for (Case& c : cases) {
-    for (const Case& ref : cases) {
-      if (ref.row.backend == kReferenceBackend && ref.row.rayset == c.row.rayset && ref.row.threads == c.row.threads &&
-          ref.row.mrays_s > 0)
-        c.row.ratio_to_embree = c.row.mrays_s / ref.row.mrays_s;
-    }
+    c.row.reference = reference;
+    if (const Case* ref = reference.empty() ? nullptr : partner(c, reference))
+      c.row.ratio_to_reference = paired_median_ratio(c.row.mrays_s_samples, ref->row.mrays_s_samples);
+    if (const Case* embree = partner(c, "embree"))
+      c.row.ratio_to_embree = paired_median_ratio(c.row.mrays_s_samples, embree->row.mrays_s_samples);
+  }
+  for (Case& c : cases) {
     results.rows.push_back(c.row);
     if (c.accuracy) {
       c.accuracy->mrays_s = c.row.mrays_s;
@@ -336,11 +376,24 @@ std::size_t write_finished_scenes(const RunOptions& options, const Metadata& run
 
 }  // namespace
 
+std::string timing_reference(const SuiteSettings& settings) {
+  const auto in_run = [&](const std::string& name) {
+    return std::find(settings.backends.begin(), settings.backends.end(), name) != settings.backends.end();
+  };
+  if (settings.reference.empty()) return in_run(kDefaultTimingReference) ? kDefaultTimingReference : "";
+  if (!in_run(settings.reference))
+    throw InputError(settings.reference_given.empty() ? "--reference" : settings.reference_given,
+                     fmt::format("{} is not one of the run's backends ({}): add it to --backend or name one of them",
+                                 settings.reference, fmt::join(settings.backends, ", ")));
+  return settings.reference;
+}
+
 RunResults run_suite(const RunOptions& options) {
   const SuiteSettings& settings = options.settings;
   // Validate everything cheap before spending minutes.
   for (const std::string& k : settings.raysets) parse_rayset_kind(k);
   for (const std::string& b : settings.backends) make_backend(b);
+  const std::string reference = timing_reference(settings);
   if (settings.rays == 0) throw InputError("", "--rays must be at least 1");
   if (settings.repetitions < 1) throw InputError("", "--reps must be at least 1");
   check_writable(options.out_csv);
@@ -381,11 +434,14 @@ RunResults run_suite(const RunOptions& options) {
       {"min_time_s", fmt::format("{}", settings.min_time)},
       {"warmup_s", fmt::format("{}", settings.warmup)},
       {"interleaved", options.interleave ? "true" : "false"},
-      {"reference_backend", kReferenceBackend},
+      {"timing", "rounds"},
+      {"reference_backend", reference},
+      {"agreement_backend", kAgreementBackend},
   };
 
-  initialize_google_benchmark(
-      {fmt::format("--benchmark_enable_random_interleaving={}", options.interleave ? "true" : "false")});
+  // Rounds are ordered by run_rounds itself, reproducibly: Google Benchmark's
+  // own random interleaving would reorder each round from a random device.
+  initialize_google_benchmark({"--benchmark_enable_random_interleaving=false"});
   RunResults results;
   std::vector<ResultRow>& rows = results.rows;
   std::vector<AccuracyRow>& accuracy_rows = results.accuracy;
@@ -393,7 +449,7 @@ RunResults run_suite(const RunOptions& options) {
   set_interrupt_message(fmt::format("no scene had finished; nothing written to {}", options.out_csv));
   try {
     for (std::size_t si = 0; si < scenes.size(); ++si) {
-      SceneResults scene = measure_scene(options, scenes[si], si, scenes.size());
+      SceneResults scene = measure_scene(options, reference, scenes[si], si, scenes.size());
       rows.insert(rows.end(), scene.rows.begin(), scene.rows.end());
       accuracy_rows.insert(accuracy_rows.end(), scene.accuracy.begin(), scene.accuracy.end());
       if (scene.camera) results.cameras.push_back(*scene.camera);

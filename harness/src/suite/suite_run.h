@@ -20,7 +20,7 @@ struct RunOptions {
   std::string out_csv;
   std::string rays_dir;              // where ray sets are stored and reused
   bool raysets_from_command_line = false;  // settings.raysets then override each scene's own list
-  bool interleave = true;            // interleave repetitions of all cases of a scene
+  bool interleave = true;            // each timing round in its own random order (false: the cases' order)
   std::string command_line;          // recorded in the metadata
   // When set, every ray is also judged by the exact referee and the accuracy
   // CSV (accuracy/accuracy_csv.h) is written here, with its throughput taken
@@ -28,9 +28,22 @@ struct RunOptions {
   std::string accuracy_csv;
 };
 
-// The baseline every backend's agreement and speed ratio are measured
-// against (not the exact referee, which is the backend named "reference").
-inline constexpr const char* kReferenceBackend = "embree";
+// The baseline every backend's agreement (agree_hit, agree_prim, ...) is
+// measured against, always built for it whatever the run's backends; not the
+// exact referee (the backend named "reference"), and not the timing
+// reference below.
+inline constexpr const char* kAgreementBackend = "embree";
+
+// The timing reference of a run without --reference (or [defaults]
+// reference) when the run has this backend; ratio_to_reference is relative
+// to it. Without it, a run has no timing reference (ratio_to_reference empty).
+inline constexpr const char* kDefaultTimingReference = "embree";
+
+// The run's timing reference: the one the settings name, which must be one of
+// the run's backends (InputError naming where it was given and the run's
+// backends otherwise), else kDefaultTimingReference when the run has it,
+// else "" (none).
+std::string timing_reference(const SuiteSettings& settings);
 
 // What a run measured: its rows as written, and what each scene's camera saw.
 struct RunResults {

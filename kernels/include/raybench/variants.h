@@ -1,6 +1,7 @@
 // The one list of kernel variants; benchmark and CSV names come from each
 // type's `name`. Adding a ray-triangle test means writing its header in
-// prim/ and adding its type to TriangleTests; nothing else is edited, and
+// prim/, including it below and adding its type to the end of TriangleTests
+// (docs/backends.md); nothing else is edited, and
 // from this list alone the harness makes the backend bvh2:<name>
 // (backends/bvh2_backend.cpp), the accuracy suite judges it
 // (meshes/accuracy.toml names "bvh2:*"), the typed specification runs over
