@@ -18,6 +18,7 @@
 #include "build_info.h"
 #include "backends/backend.h"
 #include "results/compare.h"
+#include "io/default_paths.h"
 #include "io/error.h"
 #include "io/atomic_file.h"
 #include "io/input_file.h"
@@ -38,9 +39,11 @@
 namespace raybench {
 namespace {
 
-const std::string kDefaultSuite = std::string(RAYBENCH_SOURCE_DIR) + "/meshes/default.toml";
-const std::string kDefaultOut = std::string(RAYBENCH_SOURCE_DIR) + "/results/latest.csv";
-const std::string kDefaultRaysDir = std::string(RAYBENCH_SOURCE_DIR) + "/results/rays";
+// The source tree's files from the build tree, else the installed ones and
+// the current directory (io/default_paths.h, docs/install.md).
+const std::string kDefaultSuite = default_paths().suite;
+const std::string kDefaultOut = default_paths().out_csv;
+const std::string kDefaultRaysDir = default_paths().rays_dir;
 
 // A scene argument is a suite scene's name or a mesh path / proc: spec.
 struct SceneArg {
@@ -216,8 +219,8 @@ int run(int argc, char** argv) {
 
   // raybench kernels
   KernelBenchOptions kernel_options;
-  kernel_options.out_csv = std::string(RAYBENCH_SOURCE_DIR) + "/results/kernels.csv";
-  kernel_options.out_json = std::string(RAYBENCH_SOURCE_DIR) + "/results/kernels.json";
+  kernel_options.out_csv = default_paths().kernels_csv;
+  kernel_options.out_json = default_paths().kernels_json;
   CLI::App* kernels_cmd = app.add_subcommand(
       "kernels", "Microbenchmark every kernel variant alone: ns per ray-primitive test, hit- and miss-heavy, scalar and 8-wide");
   kernels_cmd->add_option("--out,-o", kernel_options.out_csv, "Results CSV (+ .meta.toml beside it)")->capture_default_str();
@@ -231,7 +234,7 @@ int run(int argc, char** argv) {
 
   // raybench accuracy-kernels
   KernelAccuracyOptions kernel_accuracy_options;
-  kernel_accuracy_options.out_csv = std::string(RAYBENCH_SOURCE_DIR) + "/results/accuracy-kernels.csv";
+  kernel_accuracy_options.out_csv = default_paths().accuracy_kernels_csv;
   CLI::App* accuracy_kernels_cmd = app.add_subcommand(
       "accuracy-kernels", "Judge every box, OBB, sphere and triangle kernel variant alone on the extreme ray sets "
                           "against exact referees, and time it (accuracy CSV)");
@@ -269,7 +272,7 @@ int run(int argc, char** argv) {
       ->capture_default_str()->type_name("FLOAT");
 
   // raybench gate
-  std::string gate_config = std::string(RAYBENCH_SOURCE_DIR) + "/results/gate.toml";
+  std::string gate_config = default_paths().gate_config;
   std::vector<std::string> gate_baselines, gate_currents, gate_candidates;
   std::string gate_accuracy_csv, gate_json;
   bool gate_verbose = false;

@@ -15,8 +15,10 @@
 #include <unistd.h>
 
 #include "io/atomic_file.h"
+#include "io/default_paths.h"
 #include "backends/embree_backend.h"
 #include "build_info.h"
+#include "source_state.h"
 
 namespace raybench {
 namespace {
@@ -88,7 +90,8 @@ std::string source_state(const std::string& dir) {
 }
 
 const std::string& record_source_state() {
-  static const std::string state = source_state(RAYBENCH_SOURCE_DIR);
+  static const std::string state =
+      default_paths().build_tree ? source_state(RAYBENCH_SOURCE_DIR) : std::string(RAYBENCH_BUILT_SOURCE_STATE);
   return state;
 }
 

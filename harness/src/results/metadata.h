@@ -24,7 +24,9 @@ std::string source_state(const std::string& dir);
 // Reads the source tree's state (source_state of the tree this binary was
 // configured from) once, now: main() calls it first, so a commit made while
 // a run goes on (a 20-minute accuracy run) is not mistaken for the one the
-// binary was built from. Later calls keep the first answer.
+// binary was built from. Later calls keep the first answer. A binary that
+// does not run from its build tree (installed: io/default_paths.h) never
+// reads the source tree: it answers the state recorded when it was built.
 const std::string& record_source_state();
 
 // "results/latest.csv" -> "results/latest.meta.toml".
