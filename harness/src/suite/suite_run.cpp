@@ -17,6 +17,7 @@
 
 #include "accuracy/judge.h"
 #include "measure/agreement.h"
+#include "measure/answer_check.h"
 #include "io/atomic_file.h"
 #include "backends/backend.h"
 #include "measure/build_timing.h"
@@ -219,11 +220,13 @@ SceneResults measure_scene(const RunOptions& options, const LoadedScene& loaded,
         if (query_of(rs.kind) == Query::kIntersect) {
           std::vector<Hit> hits(rs.rays.size());
           executor.intersect(*backend, rs.rays, hits);
+          require_valid_hits(*backend, hits, scene.triangles.size(), scene.name + "/" + row.rayset);
           a = compare_hits(hits, ref_hits[r], rs.rays, scene.triangles);
           if (accuracy) judge_hits(*referee, rs.rays, rs.truth, hits, rs.sources, *accuracy);
         } else {
           std::vector<std::uint8_t> occ(rs.rays.size());
           executor.occluded(*backend, rs.rays, occ);
+          require_valid_occlusion(*backend, occ, scene.name + "/" + row.rayset);
           a = compare_occlusion(occ, ref_occ[r]);
           if (accuracy) judge_occlusion(rs.rays, rs.truth, occ, *accuracy);
         }
@@ -340,7 +343,12 @@ RunResults run_suite(const RunOptions& options) {
   const SuiteSettings& settings = options.settings;
   // Validate everything cheap before spending minutes.
   for (const std::string& k : settings.raysets) parse_rayset_kind(k);
-  for (const std::string& b : settings.backends) make_backend(b);
+  // Making each backend checks its name and options (a plugin: loads it);
+  // what its results depend on beyond its name goes into the metadata.
+  Metadata provenance;
+  for (const std::string& b : settings.backends)
+    for (const auto& [key, value] : make_backend(b)->provenance())
+      provenance.emplace_back(fmt::format("provenance.{}.{}", toml_key(b), toml_key(key)), value);
   if (settings.rays == 0) throw InputError("", "--rays must be at least 1");
   if (settings.repetitions < 1) throw InputError("", "--reps must be at least 1");
   check_writable(options.out_csv);
@@ -368,7 +376,7 @@ RunResults run_suite(const RunOptions& options) {
 
   std::vector<std::string> scene_names;
   for (const auto& s : scenes) scene_names.push_back(s.scene.name);
-  const Metadata run_description = {
+  Metadata run_description = {
       {"command", options.command_line},
       {"suite", options.suite.path},
       {"scenes", fmt::format("{}", fmt::join(scene_names, ","))},
@@ -383,6 +391,7 @@ RunResults run_suite(const RunOptions& options) {
       {"interleaved", options.interleave ? "true" : "false"},
       {"reference_backend", kReferenceBackend},
   };
+  run_description.insert(run_description.end(), provenance.begin(), provenance.end());
 
   initialize_google_benchmark(
       {fmt::format("--benchmark_enable_random_interleaving={}", options.interleave ? "true" : "false")});
