@@ -87,13 +87,13 @@ TEST(GoodPlugin, IsABackendThatReportsItsOwnNameClassAndProvenance) {
   EXPECT_EQ(backend_accuracy_class(plugin("good_plugin")), "fast");
   std::map<std::string, std::string> p;
   for (const auto& [k, v] : backend->provenance()) p[k] = v;
-  EXPECT_EQ(p["plugin_path"], std::filesystem::canonical(test_plugin("good_plugin")).string());
-  EXPECT_EQ(p["plugin_sha256"], sha256_of_file(test_plugin("good_plugin")));
-  EXPECT_EQ(p["plugin_sha256"].size(), 64u);
-  EXPECT_EQ(p["plugin_name"], "good_brute_force");
-  EXPECT_HAS(p["plugin_description"], "every ray against every triangle");
-  EXPECT_EQ(p["plugin_abi_version"], "1");
-  EXPECT_EQ(p["plugin_options"], "");
+  EXPECT_EQ(p["path"], std::filesystem::canonical(test_plugin("good_plugin")).string());
+  EXPECT_EQ(p["sha256"], sha256_of_file(test_plugin("good_plugin")));
+  EXPECT_EQ(p["sha256"].size(), 64u);
+  EXPECT_EQ(p["name"], "good_brute_force");
+  EXPECT_HAS(p["description"], "every ray against every triangle");
+  EXPECT_EQ(p["abi_version"], "1");
+  EXPECT_EQ(p["options"], "");
 }
 
 TEST(GoodPlugin, IsLoadedOncePerFileHoweverItIsNamed) {

@@ -72,12 +72,12 @@ class PluginBackend final : public Backend {
   std::string accuracy_class() const override { return library_.accuracy_class; }
   std::string plugin_name() const override { return library_.name; }
   std::vector<std::pair<std::string, std::string>> provenance() const override {
-    return {{"plugin_path", library_.path},
-            {"plugin_sha256", library_.sha256},
-            {"plugin_name", library_.name},
-            {"plugin_description", library_.description},
-            {"plugin_abi_version", std::to_string(table_.abi_version)},
-            {"plugin_options", options_}};
+    return {{"path", library_.path},
+            {"sha256", library_.sha256},
+            {"name", library_.name},
+            {"description", library_.description},
+            {"abi_version", std::to_string(table_.abi_version)},
+            {"options", options_}};
   }
 
   void build(const Scene& scene) override {

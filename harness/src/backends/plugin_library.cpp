@@ -201,9 +201,11 @@ const PluginLibrary& load_plugin_library(const std::string& path, const std::str
   std::error_code ec;
   const fs::path given(path);
   if (!fs::exists(given, ec))
-    throw InputError(path, fmt::format("backend '{}': plugin library not found (a plugin's options follow the first "
-                                       "':' after its .so, .dylib or .dll name)",
-                                       backend_name));
+    throw InputError(path, fmt::format("backend '{}': plugin library not found{}", backend_name,
+                                       path.find(':') == std::string::npos
+                                           ? ""
+                                           : " (a plugin's options follow the first ':' after its .so, .dylib or "
+                                             ".dll name)"));
   if (fs::is_directory(given, ec))
     throw InputError(path, fmt::format("backend '{}': a folder, not a plugin library", backend_name));
   const fs::path canonical = fs::canonical(given, ec);
