@@ -68,6 +68,7 @@ class GoodPlugins(PluginCliTestCase):
         backend = "plugin:" + plugin("good_plugin")
         out, result = self.run_suite(backend)
         self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertIn(f"primary good_brute_force ({backend})", " ".join(result.stdout.split()))
         rows = read_rows(out)
         self.assertEqual(len(rows), 8)
         mine = [r for r in rows if r["backend"] == backend]

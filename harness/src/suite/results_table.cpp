@@ -21,10 +21,12 @@ std::string camera_warning(const CameraCoverage& c) {
 std::string format_results_table(const std::vector<ResultRow>& rows, const std::vector<CameraCoverage>& cameras) {
   // Column widths follow the longest ray-set and backend names in the run;
   // with the default suite's names a line stays within 120 columns.
+  // A plugin shows the name it reports, then the name it was given.
+  const auto shown = [](const ResultRow& r) { return r.plugin.empty() ? r.backend : r.plugin + " (" + r.backend + ")"; };
   std::size_t rayset_width = 6, backend_width = 7;
   for (const ResultRow& r : rows) {
     rayset_width = std::max(rayset_width, r.rayset.size());
-    backend_width = std::max(backend_width, r.backend.size());
+    backend_width = std::max(backend_width, shown(r).size());
   }
   const auto percent = [](double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.3f}%", 100.0 * v); };
   std::string out, scene;
@@ -42,7 +44,7 @@ std::string format_results_table(const std::vector<ResultRow>& rows, const std::
     const bool spread = spreads_widely(r);
     any_spread = any_spread || spread;
     out += fmt::format("  {:<{}} {:<{}} {:>3} {:>8.2f} {:>18} {:>8} {:>7} {:>8} {:>8} {:>8.1f} {:>7.1f} {:>6}\n", r.rayset,
-                       rayset_width, r.backend, backend_width, r.threads, r.mrays_s,
+                       rayset_width, shown(r), backend_width, r.threads, r.mrays_s,
                        fmt::format("[{:.2f} - {:.2f}]{}", r.mrays_s_min, r.mrays_s_max, spread ? "!" : " "),
                        r.ratio_to_embree > 0 ? fmt::format("{:.2f}", r.ratio_to_embree) : "-",
                        fmt::format("{:.1f}%", 100.0 * r.hit_rate), percent(r.agree_hit), percent(r.agree_prim), r.build_ms,
