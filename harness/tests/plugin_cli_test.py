@@ -86,6 +86,12 @@ class GoodPlugins(PluginCliTestCase):
         self.assertEqual(provenance["name"], "good_brute_force")
         self.assertEqual(provenance["abi_version"], "1")
 
+    def test_a_plugin_named_twice_is_recorded_once(self):
+        backend = "plugin:" + plugin("good_plugin")
+        out, result = self.run_suite(backend, backend, scenes=SCENES[:1], raysets="primary")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertEqual(list(read_meta(out)["provenance"]), [backend])  # and the file is valid TOML
+
     def test_the_bvh8_plugin_traces_what_bvh8_traces(self):
         rays = self.path("rays.npy")
         made = run("rays", "--scene", "proc:terrain_spheres_small", "--kind", "diffuse", "-n", "5000", "-o", rays)

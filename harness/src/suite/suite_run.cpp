@@ -346,9 +346,13 @@ RunResults run_suite(const RunOptions& options) {
   // Making each backend checks its name and options (a plugin: loads it);
   // what its results depend on beyond its name goes into the metadata.
   Metadata provenance;
-  for (const std::string& b : settings.backends)
-    for (const auto& [key, value] : make_backend(b)->provenance())
+  for (std::size_t i = 0; i < settings.backends.size(); ++i) {
+    const std::string& b = settings.backends[i];
+    const auto backend = make_backend(b);
+    if (std::find(settings.backends.begin(), settings.backends.begin() + i, b) != settings.backends.begin() + i) continue;
+    for (const auto& [key, value] : backend->provenance())
       provenance.emplace_back(fmt::format("provenance.{}.{}", toml_key(b), toml_key(key)), value);
+  }
   if (settings.rays == 0) throw InputError("", "--rays must be at least 1");
   if (settings.repetitions < 1) throw InputError("", "--reps must be at least 1");
   check_writable(options.out_csv);
