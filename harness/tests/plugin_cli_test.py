@@ -199,10 +199,10 @@ class PluginsFailingInALaterScene(PluginCliTestCase):
     def test_a_plugin_that_crashes_the_process_leaves_the_finished_scenes_on_disk(self):
         backend = "plugin:" + plugin("bad_segfault_plugin") + ":after=1000"
         out, result = self.run_suite(backend)
-        # Killed by SIGSEGV; in the sanitizer build (scripts/test-sanitized) a sanitizer reports the bad
-        # store and ends the process first.
+        # Killed by SIGSEGV; in the sanitizer build (scripts/test-sanitized) AddressSanitizer reports the
+        # SEGV and ends the process itself.
         self.assertTrue(result.returncode == -signal.SIGSEGV or
-                        (result.returncode != 0 and "Sanitizer" in result.stderr), result.stderr[-2000:])
+                        (result.returncode != 0 and "AddressSanitizer: SEGV" in result.stderr), result.stderr[-2000:])
         self.assertFirstSceneKept(out, backend)
 
 

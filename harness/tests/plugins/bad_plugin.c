@@ -10,7 +10,7 @@
  *   BAD_NAN_T           hits at t = NaN
  *   BAD_INF_HIT         hits at t = +inf
  *   BAD_TRACE_ERROR     intersect and occluded return 7
- *   BAD_SEGFAULT        intersect and occluded write through a null pointer
+ *   BAD_SEGFAULT        intersect and occluded write to an unmapped address
  * Otherwise they are the good brute force. Option "after=N": they misbehave
  * only on scenes of more than N triangles (brute_force.h). */
 #include "brute_force.h"
@@ -54,7 +54,7 @@ __attribute__((unused)) static int bad_intersect(const void* accel, const rayben
   return 7;
 #endif
 #ifdef BAD_SEGFAULT
-  *(volatile int*)(hits[0].prim < -1000 ? (void*)hits : NULL) = 1;
+  *(volatile int*)(hits[0].prim < -1000 ? (uintptr_t)hits : (uintptr_t)16) = 1; /* an unmapped page */
 #endif
   for (size_t i = 0; i < count; ++i) {
     if (hits[i].prim == RAYBENCH_NO_HIT) continue;
@@ -79,7 +79,7 @@ static int bad_occluded(const void* accel, const raybench_ray* rays, size_t coun
   return 7;
 #endif
 #ifdef BAD_SEGFAULT
-  *(volatile int*)(occluded[0] > 200 ? (void*)occluded : NULL) = 1;
+  *(volatile int*)(occluded[0] > 200 ? (uintptr_t)occluded : (uintptr_t)16) = 1;
 #endif
   return 0;
 }
