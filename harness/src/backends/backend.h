@@ -72,6 +72,10 @@ struct BackendInfo {
   // in raybench/variants.h): the pattern "<family>:*" names all of them
   // (expand_backend_patterns).
   bool variant = false;
+  // A form to fill in, not a name make_backend accepts as it stands
+  // ("plugin:PATH.so[:options]"): listed for people, skipped by code that
+  // makes every listed backend.
+  bool placeholder = false;
 };
 
 // A backend family: every name "family[:option...]" is made by `make`
@@ -86,7 +90,7 @@ using BackendNames = std::vector<BackendInfo> (*)();
 // it from another file's static initialiser; gtest evaluates
 // INSTANTIATE_TEST_SUITE_P's ValuesIn from main). `order` places the family
 // in list_backends() (ascending; embree 100, bvh2 200, bvh8 300, bvh4 400,
-// reference 900). Throws std::logic_error for a family name registered twice.
+// reference 900, plugin 950). Throws std::logic_error for a family name registered twice.
 bool register_backend_family(std::string family, int order, BackendFactory make, BackendNames names);
 
 // Registers a backend family from its own .cpp in harness/src/backends/, at
@@ -117,7 +121,8 @@ std::vector<std::string> expand_backend_patterns(const std::vector<std::string>&
 
 // The accuracy class of a backend name (as listed; options the list does not
 // spell out, such as a trailing ":robust", are looked through): "fast",
-// "epsilon", "watertight", "reference", "exact".
+// "epsilon", "watertight", "reference", "exact". A plugin's ("plugin:...")
+// is the class it reports, which loads the library (InputError if it cannot).
 std::string backend_accuracy_class(const std::string& name);
 
 }  // namespace raybench

@@ -96,6 +96,9 @@ std::vector<std::string> expand_backend_patterns(const std::vector<std::string>&
 }
 
 std::string backend_accuracy_class(const std::string& name) {
+  // A plugin's class is what the library reports (loaded once per process):
+  // its name lists no class.
+  if (name.rfind("plugin:", 0) == 0) return make_backend(name)->accuracy_class();
   const std::vector<BackendInfo> all = list_backends();
   // A builder option or 'reinsert' (bvh2_builders.h) changes the tree, not
   // the accuracy class, and may stand anywhere: "bvh2:lbvh:mt_seed" and

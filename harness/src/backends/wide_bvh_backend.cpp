@@ -27,7 +27,7 @@
 #include "backends/bvh_options.h"
 #include "io/error.h"
 #include "raybench/bvh/bvh2_builders.h"
-#include "raybench/bvh/wide_bvh_traverse.h"
+#include "raybench/bvh/wide_bvh_batch.h"
 
 namespace raybench {
 namespace {
@@ -41,33 +41,8 @@ class WideBvhBackend final : public Backend {
   const std::string& name() const override { return name_; }
 
   void build(const Scene& scene) override {
-    Bvh2BuildOptions options;
-    // The quality builds (spatial splits, reinsertion) build the BVH2 with
-    // small leaves, scored as scalar tests: the collapse then gathers subtrees
-    // of up to W triangles into packs where the wide tree's SAH says so
-    // (wide_bvh_collapse.cpp), which fills nodes better. Measured on Sponza:
-    // 4-10 % more rays/s, for 1.8x the build time. The default build keeps
-    // leaves of up to W triangles (the SAH counts them in packs of W), as
-    // fast to build as Embree's medium build.
-    const bool quality = builder_ == Bvh2Builder::kSbvh || reinsertion_passes_ > 0;
-    options.leaf_granularity = quality ? 1 : W;
-    options.max_leaf_size = W;  // a BVH2 leaf fits one pack
-    options.reinsertion_passes = reinsertion_passes_;
-    // Any-hit traversal visits the children in lane order: the smallest box
-    // first for the default build, the most likely to end the ray per cost
-    // first for the quality builds (WideLaneOrder::kOcclusion).
-    // Measured on shadow rays, one thread, interleaved: smallest first made
-    // the default build 1.21x faster on Sponza, 1.01x on Conference, but
-    // bvh8:reinsert 0.89x and 0.93x, bvh8:sbvh:reinsert 1.01x and 0.97x
-    // (against the BVH2's order). The occlusion order against the BVH2's,
-    // the quality builds with and without watertight leaves, 11 scenes (44
-    // rows): geometric mean +2.9 %, 38 rows faster, Sponza-Dabrovic +5 to
-    // +18 %, Sponza +3 to +10 %, Conference +4 to +7 %, but Lucy -9 to
-    // -13 %. On the default build it was -18 % on Sponza (+15 % on
-    // Sponza-Dabrovic, the mean unchanged): smallest first stays there.
-    const WideLaneOrder lanes = quality ? WideLaneOrder::kOcclusion : WideLaneOrder::kByArea;
     bvh_ = {};  // the old tree freed first, as Embree releases its old scene first
-    bvh_ = collapse_bvh2<W>(build_bvh2(scene.triangles, builder_, options), scene.triangles, Leaf::kLeaves, lanes);
+    bvh_ = build_wide_bvh<W, Leaf>(scene.triangles, builder_, reinsertion_passes_);
   }
 
   std::size_t memory_bytes() const override { return bvh_.memory_bytes(); }
@@ -76,21 +51,13 @@ class WideBvhBackend final : public Backend {
   // pack tests cost 1 each (computed here, outside the timed build).
   double sah_cost() const override { return bvh_.sah_cost(); }
 
+  // The same code as the in-tree plugin wrapping bvh8 (bvh/wide_bvh_batch.h).
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
-    // Leaves that do not carry their triangles report pack slots, mapped
-    // to triangles here, after the batch (traverse_wide's PackSlots).
-    constexpr bool kSlots = !Leaf::kPrimsInPack;
-    for (std::size_t i = 0; i < rays.size(); ++i)
-      hits[i] = is_traceable(rays[i]) ? traverse_wide<false, Leaf, BoxTest, kSlots>(bvh_, with_nonnegative_tnear(rays[i]))
-                                      : Hit{};
-    if constexpr (kSlots)
-      for (Hit& h : hits)
-        if (h.hit()) h.prim = bvh_.pack_prims[static_cast<std::uint32_t>(h.prim)];
+    intersect_wide_batch<Leaf, BoxTest>(bvh_, rays, hits);
   }
 
   void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override {
-    for (std::size_t i = 0; i < rays.size(); ++i)
-      occluded[i] = is_traceable(rays[i]) && occluded_wide<Leaf, BoxTest>(bvh_, with_nonnegative_tnear(rays[i]));
+    occluded_wide_batch<Leaf, BoxTest>(bvh_, rays, occluded);
   }
 
  private:

@@ -34,6 +34,7 @@
 #include "suite/settings_rules.h"
 #include "suite/suite.h"
 #include "suite/suite_run.h"
+#include "measure/answer_check.h"
 #include "measure/trace.h"
 
 namespace raybench {
@@ -547,6 +548,7 @@ int run(int argc, char** argv) {
       std::vector<std::uint8_t> occ(rays.size());
       executor.occluded(*backend, rays, occ);
       force_misses(screened, occ);
+      require_valid_occlusion(*backend, occ, fmt::format("{} ({})", s.scene.name, trace_rays));
       std::vector<double> out(occ.begin(), occ.end());
       for (std::uint8_t o : occ) hits += o;
       write_npy_f64(trace_out, out, rays.size(), 1);
@@ -556,6 +558,7 @@ int run(int argc, char** argv) {
       std::vector<Hit> h(rays.size());
       executor.intersect(*backend, rays, h);
       force_misses(screened, h);
+      require_valid_hits(*backend, h, s.scene.triangles.size(), fmt::format("{} ({})", s.scene.name, trace_rays));
       std::vector<double> out(rays.size() * 4);
       for (std::size_t i = 0; i < h.size(); ++i) {
         out[4 * i + 0] = h[i].t;

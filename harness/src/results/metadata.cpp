@@ -1,5 +1,6 @@
 #include "results/metadata.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -73,12 +74,20 @@ std::string toml_string(const std::string& s) {
   for (char c : s) {
     if (c == '"' || c == '\\') out += '\\';
     if (c == '\n') { out += "\\n"; continue; }
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) { out += fmt::format("\\u{:04x}", static_cast<int>(c)); continue; }
     out += c;
   }
   return out + "\"";
 }
 
 }  // namespace
+
+std::string toml_key(const std::string& name) {
+  const bool bare = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+  });
+  return bare ? name : toml_string(name);
+}
 
 std::string source_state(const std::string& dir) {
   const std::string git = "git -C '" + dir + "' ";

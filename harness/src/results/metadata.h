@@ -32,6 +32,12 @@ const std::string& record_source_state();
 // "results/latest.csv" -> "results/latest.meta.toml".
 std::string metadata_path_for(const std::string& csv_path);
 
+// Keys are written as given: a dotted key (provenance.<backend>.<field>)
+// names each part with toml_key.
 void write_metadata(const std::string& path, const Metadata& metadata);
+
+// A TOML key for `name`: bare when made of A-Za-z0-9_-, quoted otherwise
+// ("plugin:build/x.so").
+std::string toml_key(const std::string& name);
 
 }  // namespace raybench

@@ -17,6 +17,7 @@
 
 #include "accuracy/judge.h"
 #include "measure/agreement.h"
+#include "measure/answer_check.h"
 #include "io/atomic_file.h"
 #include "backends/backend.h"
 #include "measure/build_timing.h"
@@ -242,12 +243,14 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
           std::vector<Hit> hits(rs.rays.size());
           executor.intersect(*backend, rs.screened.rays, hits);
           force_misses(rs.screened, hits);
+          require_valid_hits(*backend, hits, scene.triangles.size(), scene.name + "/" + row.rayset);
           a = compare_hits(hits, ref_hits[r], rs.screened.rays, scene.triangles);
           if (accuracy) judge_hits(*referee, rs.rays, rs.truth, hits, rs.sources, *accuracy);
         } else {
           std::vector<std::uint8_t> occ(rs.rays.size());
           executor.occluded(*backend, rs.screened.rays, occ);
           force_misses(rs.screened, occ);
+          require_valid_occlusion(*backend, occ, scene.name + "/" + row.rayset);
           a = compare_occlusion(occ, ref_occ[r]);
           if (accuracy) judge_occlusion(rs.rays, rs.truth, occ, *accuracy);
         }
@@ -392,7 +395,16 @@ RunResults run_suite(const RunOptions& options) {
   const SuiteSettings& settings = options.settings;
   // Validate everything cheap before spending minutes.
   for (const std::string& k : settings.raysets) parse_rayset_kind(k);
-  for (const std::string& b : settings.backends) make_backend(b);
+  // Making each backend checks its name and options (a plugin: loads it);
+  // what its results depend on beyond its name goes into the metadata.
+  Metadata provenance;
+  for (std::size_t i = 0; i < settings.backends.size(); ++i) {
+    const std::string& b = settings.backends[i];
+    const auto backend = make_backend(b);
+    if (std::find(settings.backends.begin(), settings.backends.begin() + i, b) != settings.backends.begin() + i) continue;
+    for (const auto& [key, value] : backend->provenance())
+      provenance.emplace_back(fmt::format("provenance.{}.{}", toml_key(b), toml_key(key)), value);
+  }
   const std::string reference = timing_reference(settings);
   if (settings.rays == 0) throw InputError("", "--rays must be at least 1");
   if (settings.repetitions < 1) throw InputError("", "--reps must be at least 1");
@@ -421,7 +433,7 @@ RunResults run_suite(const RunOptions& options) {
 
   std::vector<std::string> scene_names;
   for (const auto& s : scenes) scene_names.push_back(s.scene.name);
-  const Metadata run_description = {
+  Metadata run_description = {
       {"command", options.command_line},
       {"suite", options.suite.path},
       {"scenes", fmt::format("{}", fmt::join(scene_names, ","))},
@@ -438,6 +450,7 @@ RunResults run_suite(const RunOptions& options) {
       {"reference_backend", reference},
       {"agreement_backend", kAgreementBackend},
   };
+  run_description.insert(run_description.end(), provenance.begin(), provenance.end());
 
   // Rounds are ordered by run_rounds itself, reproducibly: Google Benchmark's
   // own random interleaving would reorder each round from a random device.
