@@ -33,10 +33,13 @@
  * - Errors: a plugin never aborts the process. `build` and `check_options`
  *   report failure by returning NULL / non-zero with a message in `error`;
  *   `intersect` and `occluded` return non-zero. raybench then stops with one
- *   line naming the plugin, and keeps every result row it had finished. It
- *   also checks the answers (outside the timing): a hit with a primitive id
- *   outside [0, triangle_count), or a NaN t, is an error naming how many
- *   rays had it.
+ *   line naming the plugin, and keeps every result row it had finished.
+ *   Exceptions must not leave a C++ plugin (unwinding through a C interface
+ *   is undefined behaviour); raybench catches what escapes anyway, as a
+ *   failure of the call. raybench also checks the answers, outside the
+ *   timing: a hit with a primitive id outside [0, triangle_count), a NaN t,
+ *   a hit at infinite t, or an occlusion flag other than 0 or 1 is an error
+ *   naming how many rays had it.
  *
  * Versioning: RAYBENCH_PLUGIN_ABI_VERSION changes whenever this file changes
  * incompatibly; raybench refuses a plugin built for another version, naming
@@ -87,6 +90,8 @@ typedef struct raybench_build_input {
  * terminated, truncated to the buffer. */
 #define RAYBENCH_PLUGIN_ERROR_SIZE 512
 
+/* Every field is required except `description` (NULL reads as "") and
+ * `check_options` (NULL accepts every options string). */
 typedef struct raybench_plugin_table {
   /* RAYBENCH_PLUGIN_ABI_VERSION as the plugin was compiled. */
   uint32_t abi_version;
