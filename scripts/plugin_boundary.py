@@ -7,7 +7,7 @@ interleaved rounds, so every round gives one paired ratio plugin / built-in per 
 For each scene and ray set (one thread), the table gives both medians and the median of the paired
 ratios with their min and max over the rounds. The target (issue 30): the plugin traces within 2 %
 of the built-in, i.e. a median paired ratio >= 0.98, on every row; the geometric mean is reported
-too. A row below the target is said to be within or beyond the run's noise (its ratios' range
+too, overall and per ray set. A row below the target is said to be within or beyond the run's noise (its ratios' range
 reaching 1.0 or not). Prints Markdown (or writes --out). Bad input: one line on stderr, exit 2.
 """
 import argparse
@@ -84,6 +84,11 @@ def report(path, plugin, builtin, target):
     gm = geometric_mean(medians)
     lines.append(f"Geometric mean of the paired ratios: {gm:.3f} over {len(medians)} rows; "
                  f"lowest {min(medians):.3f}, highest {max(medians):.3f}.")
+    per_rayset = []
+    for rayset in ordered(rs for _, rs, _, _, _ in pairs):
+        of_set = [statistics.median(ratios) for _, rs, _, _, ratios in pairs if rs == rayset]
+        per_rayset.append(f"{rayset} {geometric_mean(of_set):.3f}")
+    lines.append(f"Per ray set: {', '.join(per_rayset)}.")
     lines.append("")
     lines.append("Verdict: " + ("every row meets the target." if not below else
                                 f"{len(below)} row(s) below the target: {', '.join(below)}."))

@@ -54,6 +54,7 @@ class PluginBoundary(unittest.TestCase):
                          row("bunny", "diffuse", "embree", [3, 3, 3])])
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertIn("over 1 rows", r.stdout)
+        self.assertIn("Per ray set: diffuse 1.000.", r.stdout)
 
     def test_unpaired_samples_are_refused(self):
         r = self.run_on([row("bunny", "diffuse", "bvh8", [4, 4, 4]), row("bunny", "diffuse", PLUGIN, [4, 4])])
