@@ -2,7 +2,7 @@
 // place: the built-in backends (harness/src/backends/wide_bvh_backend.cpp)
 // and the in-tree plugin that wraps bvh8 (plugin/bvh8/bvh8_plugin.cpp) call
 // exactly these functions, so both build the same tree and trace the same
-// hits with the same code, placed alike (RAYBENCH_BATCH_LOOP).
+// hits with the same code.
 #pragma once
 
 #include <cstdint>
@@ -10,7 +10,6 @@
 
 #include "raybench/bvh/bvh2_builders.h"
 #include "raybench/bvh/wide_bvh_traverse.h"
-#include "raybench/math/inline.h"
 
 namespace raybench {
 
@@ -49,7 +48,7 @@ WideBvh<W> build_wide_bvh(std::span<const Triangle> triangles, Bvh2Builder build
 // Closest hit of every ray; untraceable rays (is_traceable) are misses and
 // a negative tnear is raised to 0 (with_nonnegative_tnear).
 template <typename Leaf, typename BoxTest, int W>
-RAYBENCH_BATCH_LOOP inline void intersect_wide_batch(const WideBvh<W>& bvh, std::span<const Ray> rays, std::span<Hit> hits) {
+inline void intersect_wide_batch(const WideBvh<W>& bvh, std::span<const Ray> rays, std::span<Hit> hits) {
   // Leaves that do not carry their triangles report pack slots, mapped
   // to triangles here, after the batch (traverse_wide's PackSlots).
   constexpr bool kSlots = !Leaf::kPrimsInPack;
@@ -63,7 +62,7 @@ RAYBENCH_BATCH_LOOP inline void intersect_wide_batch(const WideBvh<W>& bvh, std:
 
 // Any hit of every ray within its interval: 1 when occluded, 0 otherwise.
 template <typename Leaf, typename BoxTest, int W>
-RAYBENCH_BATCH_LOOP inline void occluded_wide_batch(const WideBvh<W>& bvh, std::span<const Ray> rays, std::span<std::uint8_t> occluded) {
+inline void occluded_wide_batch(const WideBvh<W>& bvh, std::span<const Ray> rays, std::span<std::uint8_t> occluded) {
   for (std::size_t i = 0; i < rays.size(); ++i)
     occluded[i] = is_traceable(rays[i]) && occluded_wide<Leaf, BoxTest>(bvh, with_nonnegative_tnear(rays[i]));
 }
