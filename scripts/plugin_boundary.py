@@ -120,7 +120,7 @@ def main(argv=None):
     try:
         text, _ = report(args.csv, args.plugin, args.builtin, args.target)
     except InputError as e:
-        print(f"plugin-boundary-report: {e}", file=sys.stderr)
+        print(f"plugin-boundary: error: {e}", file=sys.stderr)
         return 2
     if args.out:
         with open(args.out, "w", encoding="utf-8") as f:

@@ -5,9 +5,11 @@ last line (progress lines may precede it).
 
 ctest sets RAYBENCH (the binary) and the mesh folders (harness/tests/CMakeLists.txt).
 """
+import csv
 import os
 import subprocess
 import tempfile
+import tomllib
 import unittest
 
 RAYBENCH = os.environ["RAYBENCH"]
@@ -18,6 +20,18 @@ def run(*args, env=None, timeout=300):
     """raybench with these arguments; `env` adds to the environment."""
     return subprocess.run([RAYBENCH, *args], capture_output=True, text=True, timeout=timeout,
                           env={**os.environ, **(env or {})})
+
+
+def read_rows(path):
+    """A CSV's rows as dicts, every field as text."""
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def read_meta(csv_path):
+    """The .meta.toml beside a results CSV."""
+    with open(csv_path[:-len(".csv")] + ".meta.toml", "rb") as f:
+        return tomllib.load(f)
 
 
 class CliTestCase(unittest.TestCase):

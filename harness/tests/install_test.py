@@ -9,7 +9,6 @@ deliberately wrong one (MY_KERNEL_DROP_EVERY) fails it on accuracy.
 ctest sets RAYBENCH_SOURCE_DIR, RAYBENCH_BINARY_DIR (the build tree to install from), RAYBENCH_CMAKE,
 RAYBENCH_CMAKE_GENERATOR and the mesh folders (harness/tests/CMakeLists.txt).
 """
-import csv
 import glob
 import json
 import os
@@ -17,6 +16,8 @@ import shutil
 import subprocess
 import tempfile
 import unittest
+
+from cli_testing import read_rows
 
 SOURCE_DIR = os.path.realpath(os.environ["RAYBENCH_SOURCE_DIR"])
 BINARY_DIR = os.path.realpath(os.environ["RAYBENCH_BINARY_DIR"])
@@ -30,10 +31,6 @@ def call(args, cwd=None, env=None, timeout=300):
     return subprocess.run(args, cwd=cwd, capture_output=True, text=True, timeout=timeout,
                           env={**os.environ, **(env or {})})
 
-
-def read_rows(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
 
 
 class Installed:

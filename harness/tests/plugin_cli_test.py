@@ -6,17 +6,15 @@ leaves the earlier scene's rows on disk (status partial); one that crashes the p
 ctest sets RAYBENCH and RAYBENCH_PLUGIN_<NAME> (the test plugins of harness/tests/plugins) and
 RAYBENCH_BVH8_PLUGIN (harness/tests/CMakeLists.txt).
 """
-import csv
 import hashlib
 import os
 import signal
-import tomllib
 import unittest
 
 import numpy as np
 
 import cli_testing
-from cli_testing import CliTestCase
+from cli_testing import CliTestCase, read_meta, read_rows
 
 # Scene 1 has 516 triangles, scene 2 has 2208: a plugin given "after=1000" misbehaves in scene 2 only.
 SCENES = ["proc:axis_boxes", "proc:sphere"]
@@ -30,14 +28,6 @@ def run(*args):
     return cli_testing.run(*args, timeout=300)
 
 
-def read_rows(path):
-    with open(path) as f:
-        return list(csv.DictReader(f))
-
-
-def read_meta(csv_path):
-    with open(csv_path[:-len(".csv")] + ".meta.toml", "rb") as f:
-        return tomllib.load(f)
 
 
 class PluginCliTestCase(CliTestCase):

@@ -4,7 +4,6 @@ moment; `--reference NAME` (or `[defaults] reference`) makes ratio_to_reference 
 rounds of (row sample / reference sample), and ratio_to_embree is the same against embree. Every
 backend traces the screened rays: untraceable rays are misses for all (rays/screening.h).
 """
-import csv
 import math
 import os
 import re
@@ -13,12 +12,8 @@ import unittest
 
 import numpy as np
 
-from cli_testing import CliTestCase, run
+from cli_testing import CliTestCase, read_rows, run
 
-
-def read_rows(path):
-    with open(path) as f:
-        return list(csv.DictReader(f))
 
 
 def metadata(path):

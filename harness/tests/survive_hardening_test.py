@@ -4,17 +4,15 @@ a later scene keeps the earlier rows; the kernel benchmark leaves no *.tmp.gbenc
 
 Run through ctest (harness/tests/CMakeLists.txt sets RAYBENCH).
 """
-import csv
 import glob
 import os
 import signal
 import subprocess
 import time
-import tomllib
 import unittest
 
 import cli_testing
-from cli_testing import RAYBENCH, CliTestCase
+from cli_testing import RAYBENCH, CliTestCase, read_meta, read_rows
 
 # A closed cube, 12 triangles: the run's third scene, a mesh file.
 CUBE_OBJ = """v -1 -1 -1
@@ -45,14 +43,6 @@ def run(*args):
     return cli_testing.run(*args, timeout=600)
 
 
-def read_rows(path):
-    with open(path) as f:
-        return list(csv.DictReader(f))
-
-
-def read_meta(csv_path):
-    with open(csv_path[:-len(".csv")] + ".meta.toml", "rb") as f:
-        return tomllib.load(f)
 
 
 class SurviveTestCase(CliTestCase):
