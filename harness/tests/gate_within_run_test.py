@@ -130,6 +130,27 @@ class Speed(WithinRunTestCase):
                                     "current": [self.path("run.csv")], "baseline": [], "candidates": [CAND],
                                     "failures": [], "notes": []})
 
+    def test_with_several_runs_a_slowdown_counts_only_when_every_run_shows_it(self):
+        slower = [0.70, 0.72, 0.69, 0.71, 0.68, 0.70, 0.73, 0.70, 0.71]
+        fluke = self.write_run("fluke", run_rows(slower))
+        level = self.write_run("level", run_rows([1.0] * 9))
+        again = self.write_run("again", run_rows(slower))
+        result = self.gate(fluke, "--current", level)
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        self.assertIn(f"terrain/primary/{CAND}/threads:1: slower in {fluke} but not in {level}: not counted",
+                      result.stdout)
+        result = self.gate(fluke, "--current", again)
+        self.assertEqual(result.returncode, 1, result.stdout + result.stderr)
+        self.assertIn(f"FAIL: terrain/primary/{CAND}/threads:1: 30.0% slower", result.stdout)
+
+    def test_runs_gated_together_share_their_reference(self):
+        first = self.write_run("first", run_rows())
+        other = self.write("other", [row("terrain", CAND, BUSY, reference=CAND), row("terrain", BASE, BUSY, reference=CAND)],
+                           rounds_metadata(CAND))
+        result = self.gate(first, "--current", other)
+        self.assertEqual(result.returncode, 2, result.stdout + result.stderr)
+        self.assertIn("must share their reference", result.stderr)
+
     def test_slower_by_less_than_the_limit_passes(self):
         result = self.gate(self.write_run("run", run_rows([0.95] * 9)))
         self.assertEqual(result.returncode, 0, result.stdout + result.stderr)

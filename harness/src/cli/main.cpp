@@ -285,8 +285,8 @@ int run(int argc, char** argv) {
                        "Baseline results CSV; give it more than once to pool independent runs of the baseline "
                        "(each repetition keeps the ratio to the reference of its own run)");
   gate_cmd->add_option("--current", gate_currents,
-                       "Current results CSV; with --baseline, give it twice (two independent runs) to count a "
-                       "throughput regression only when both show it")
+                       "Current results CSV; give it more than once (independent runs) to count a throughput "
+                       "regression only when every run shows it")
       ->required();
   gate_cmd->add_option("--candidate", gate_candidates,
                        "Gate within the --current run (no --baseline): this backend, as named in the run (e.g. "
@@ -350,8 +350,6 @@ int run(int argc, char** argv) {
       throw InputError("--candidate", "gates within one run, --baseline against another run: give one or the other");
     if (!within_run && gate_baselines.empty())
       throw InputError("gate", "give --baseline FILE (gate against another run) or --candidate NAME (within the --current run)");
-    if (within_run && gate_currents.size() != 1)
-      throw InputError("--current", "the gate within one run takes one --current run");
     if (!within_run && !gate_accuracy_csv.empty())
       throw InputError("--accuracy", "judges candidates within one run: give --candidate NAME, not --baseline");
     check_input_file(gate_config, "gate config (TOML)");
@@ -371,7 +369,7 @@ int run(int argc, char** argv) {
     GateResult g;
     std::string summary;
     if (within_run) {
-      g = run_within_run_gate(current, gate_candidates, config);
+      g = run_within_run_gate(currents, gate_candidates, config);
       if (!gate_accuracy_csv.empty())
         gate_accuracy(read_accuracy_csv(gate_accuracy_csv), gate_accuracy_csv, current.reference, gate_candidates, config, g);
       summary = fmt::format("{} against the reference {} in {}", fmt::join(gate_candidates, ", "), current.reference,

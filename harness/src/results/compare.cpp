@@ -835,6 +835,31 @@ GateResult run_within_run_gate(const ResultsFile& run, const std::vector<std::st
   return g;
 }
 
+GateResult run_within_run_gate(const std::vector<ResultsFile>& runs, const std::vector<std::string>& candidates,
+                               const GateConfig& config) {
+  GateResult g = run_within_run_gate(runs.front(), candidates, config);
+  for (std::size_t i = 1; i < runs.size(); ++i) {
+    if (runs[i].reference != runs.front().reference)
+      throw InputError(runs[i].path, fmt::format("its reference backend is '{}', {}'s is '{}': runs gated together "
+                                                 "must share their reference",
+                                                 runs[i].reference, runs.front().path, runs.front().reference));
+    const GateResult other = run_within_run_gate(runs[i], candidates, config);
+    std::erase_if(g.failures, [&](const GateFailure& f) {
+      if (f.check != "speed") return false;
+      const bool again = std::any_of(other.failures.begin(), other.failures.end(), [&](const GateFailure& o) {
+        return o.check == "speed" && o.scene == f.scene && o.rayset == f.rayset && o.backend == f.backend &&
+               o.threads == f.threads;
+      });
+      if (!again)
+        g.notes.push_back(fmt::format("{}/{}/{}/threads:{}: slower in {} but not in {}: not counted (a regression "
+                                      "reproduces in every run)",
+                                      f.scene, f.rayset, f.backend, f.threads, runs.front().path, runs[i].path));
+      return !again;
+    });
+  }
+  return g;
+}
+
 std::string format_paired_speeds(const GateResult& g) {
   std::vector<std::vector<std::string>> table = {
       {"scene", "rayset", "backend", "thr", "rounds", "x " + g.reference, "[min - max]", "p (slower)"}};

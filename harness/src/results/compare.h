@@ -250,6 +250,14 @@ GateResult run_gate(const ResultsFile& baseline, const std::vector<ResultsFile>&
 GateResult run_within_run_gate(const ResultsFile& run, const std::vector<std::string>& candidates,
                                const GateConfig& config);
 
+// The same over several runs (independent processes of the same builds): as
+// in run_gate, a speed failure counts only when every run shows it for the
+// same row (a note names the rows slower in some runs only); every other
+// check is the first run's. Throws InputError when the runs' references
+// differ.
+GateResult run_within_run_gate(const std::vector<ResultsFile>& runs, const std::vector<std::string>& candidates,
+                               const GateConfig& config);
+
 // The gate's verdicts as JSON (docs/gating.md): {"verdict", "mode",
 // "reference", "current", "baseline", "candidates", "failures", "notes"}.
 std::string format_gate_json(const GateResult& g, const std::vector<std::string>& currents,
