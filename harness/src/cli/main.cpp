@@ -543,9 +543,7 @@ int run(int argc, char** argv) {
     executor.run([&] { backend->build(s.scene); });
     std::size_t hits = 0;
     if (trace_occluded) {
-      std::vector<std::uint8_t> occ(rays.size());
-      executor.occluded(*backend, rays, occ);
-      force_misses(screened, occ);
+      const std::vector<std::uint8_t> occ = executor.occlusion_answers(*backend, screened);
       require_valid_occlusion(*backend, occ, fmt::format("{} ({})", s.scene.name, trace_rays));
       std::vector<double> out(occ.begin(), occ.end());
       for (std::uint8_t o : occ) hits += o;
@@ -553,9 +551,7 @@ int run(int argc, char** argv) {
       fmt::print("occlusion query: {} of {} rays occluded; wrote (N, 1) occlusion flags (not hit records) to {}\n", hits,
                  rays.size(), trace_out);
     } else {
-      std::vector<Hit> h(rays.size());
-      executor.intersect(*backend, rays, h);
-      force_misses(screened, h);
+      const std::vector<Hit> h = executor.answers(*backend, screened);
       require_valid_hits(*backend, h, s.scene.triangles.size(), fmt::format("{} ({})", s.scene.name, trace_rays));
       std::vector<double> out(rays.size() * 4);
       for (std::size_t i = 0; i < h.size(); ++i) {

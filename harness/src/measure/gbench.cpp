@@ -12,6 +12,8 @@
 
 #include <fmt/format.h>
 
+#include "scene/random.h"
+
 namespace raybench {
 
 double median(std::vector<double> v) {
@@ -88,13 +90,6 @@ const std::vector<double>& CollectingReporter::samples(const std::string& name) 
 
 namespace {
 
-std::uint64_t splitmix64(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
-}
-
 // One round's single repetition of every case: its sample and the iteration
 // count it ran, or the error it reported.
 class RoundReporter : public benchmark::BenchmarkReporter {
@@ -132,12 +127,12 @@ class RoundReporter : public benchmark::BenchmarkReporter {
 std::vector<std::size_t> round_order(std::size_t n, std::uint64_t seed, int round) {
   std::vector<std::size_t> order(n);
   std::iota(order.begin(), order.end(), std::size_t{0});
-  std::uint64_t state = seed ^ (0x2545f4914f6cdd1dull * (static_cast<std::uint64_t>(round) + 1));
+  Rng rng(seed, static_cast<std::uint64_t>(round), 0);  // one stream per round (scene/random.h)
   for (std::size_t i = n; i > 1; --i) {
     // An unbiased index in [0, i): reject the top remainder of the 64-bit range.
     const std::uint64_t limit = ~std::uint64_t{0} - (~std::uint64_t{0} % i);
-    std::uint64_t x = splitmix64(state);
-    while (x >= limit) x = splitmix64(state);
+    std::uint64_t x = rng.next_u64();
+    while (x >= limit) x = rng.next_u64();
     std::swap(order[i - 1], order[static_cast<std::size_t>(x % i)]);
   }
   return order;

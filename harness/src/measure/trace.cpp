@@ -46,4 +46,18 @@ void TraceExecutor::occluded(const Backend& backend, std::span<const Ray> rays, 
   chunked(*arena_, threads_, rays, occluded, [&](auto r, auto o) { backend.occluded(r, o); });
 }
 
+std::vector<Hit> TraceExecutor::answers(const Backend& backend, const ScreenedRays& rays) const {
+  std::vector<Hit> hits(rays.rays.size());
+  intersect(backend, rays.rays, hits);
+  force_misses(rays, hits);
+  return hits;
+}
+
+std::vector<std::uint8_t> TraceExecutor::occlusion_answers(const Backend& backend, const ScreenedRays& rays) const {
+  std::vector<std::uint8_t> occ(rays.rays.size());
+  occluded(backend, rays.rays, occ);
+  force_misses(rays, occ);
+  return occ;
+}
+
 }  // namespace raybench

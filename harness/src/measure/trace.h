@@ -8,10 +8,12 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include <tbb/task_arena.h>
 
 #include "backends/backend.h"
+#include "rays/screening.h"
 
 namespace raybench {
 
@@ -26,6 +28,11 @@ class TraceExecutor {
 
   void intersect(const Backend& backend, std::span<const Ray> rays, std::span<Hit> hits) const;
   void occluded(const Backend& backend, std::span<const Ray> rays, std::span<std::uint8_t> occluded) const;
+  // The answers that count (untimed: agreement, the referee, `raybench
+  // trace`): every ray of a screened set traced, and the answers of the rays
+  // screened out forced to misses (rays/screening.h).
+  std::vector<Hit> answers(const Backend& backend, const ScreenedRays& rays) const;
+  std::vector<std::uint8_t> occlusion_answers(const Backend& backend, const ScreenedRays& rays) const;
   // Runs f inside the arena, so that builds also use exactly `threads` threads.
   void run(const std::function<void()>& f) const;
 

@@ -29,6 +29,7 @@
 #include "rays/rayset.h"
 #include "rays/screening.h"
 #include "referee/referee.h"
+#include "scene/random.h"
 #include "scene/scene.h"
 #include "suite/results_table.h"
 #include "suite/scene_selection.h"
@@ -91,9 +92,7 @@ struct SceneResults {
 // The seed of a scene's round orders: the run's seed and the scene's name,
 // so that every scene is shuffled differently and every run alike.
 std::uint64_t round_seed(std::uint64_t seed, const std::string& scene) {
-  std::uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a
-  for (const char c : scene) h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ull;
-  return h ^ (seed * 0x9e3779b97f4a7c15ull);
+  return hash_string(scene.c_str()) ^ (seed * 0x9e3779b97f4a7c15ull);
 }
 
 // One scene, scene `index` of `count`: its ray sets (made or reused) and
@@ -168,16 +167,8 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
     std::vector<std::vector<Hit>> ref_hits(raysets.size());
     std::vector<std::vector<std::uint8_t>> ref_occ(raysets.size());
     for (std::size_t r = 0; r < raysets.size(); ++r) {
-      const ScreenedRays& screened = raysets[r].screened;
-      if (query_of(raysets[r].kind) == Query::kIntersect) {
-        ref_hits[r].resize(screened.rays.size());
-        executor.intersect(*baseline, screened.rays, ref_hits[r]);
-        force_misses(screened, ref_hits[r]);
-      } else {
-        ref_occ[r].resize(screened.rays.size());
-        executor.occluded(*baseline, screened.rays, ref_occ[r]);
-        force_misses(screened, ref_occ[r]);
-      }
+      if (query_of(raysets[r].kind) == Query::kIntersect) ref_hits[r] = executor.answers(*baseline, raysets[r].screened);
+      else ref_occ[r] = executor.occlusion_answers(*baseline, raysets[r].screened);
     }
     baseline.reset();
     // What the camera sees, once per scene: Embree's primary hits.
@@ -240,16 +231,12 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
         // Untimed: the answers that count, screened rays forced to misses;
         // the referee judges them against the rays as stored.
         if (query_of(rs.kind) == Query::kIntersect) {
-          std::vector<Hit> hits(rs.rays.size());
-          executor.intersect(*backend, rs.screened.rays, hits);
-          force_misses(rs.screened, hits);
+          const std::vector<Hit> hits = executor.answers(*backend, rs.screened);
           require_valid_hits(*backend, hits, scene.triangles.size(), scene.name + "/" + row.rayset);
           a = compare_hits(hits, ref_hits[r], rs.screened.rays, scene.triangles);
           if (accuracy) judge_hits(*referee, rs.rays, rs.truth, hits, rs.sources, *accuracy);
         } else {
-          std::vector<std::uint8_t> occ(rs.rays.size());
-          executor.occluded(*backend, rs.screened.rays, occ);
-          force_misses(rs.screened, occ);
+          const std::vector<std::uint8_t> occ = executor.occlusion_answers(*backend, rs.screened);
           require_valid_occlusion(*backend, occ, scene.name + "/" + row.rayset);
           a = compare_occlusion(occ, ref_occ[r]);
           if (accuracy) judge_occlusion(rs.rays, rs.truth, occ, *accuracy);
