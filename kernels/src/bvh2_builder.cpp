@@ -289,25 +289,29 @@ class Builder {
 
 }  // namespace
 
-Bvh2 build_bvh2_binned_sah(std::span<const Triangle> triangles, const Bvh2BuildOptions& options) {
+namespace {
+
+// The build over n primitives whose boxes bounds_of(i) gives.
+template <typename BoundsOf>
+Bvh2 build_binned_sah(std::size_t n, BoundsOf bounds_of, const Bvh2BuildOptions& options) {
   Bvh2 bvh;
-  if (triangles.empty()) {
+  if (n == 0) {
     bvh.nodes.resize(1);  // an empty leaf whose empty box no ray enters
     return bvh;
   }
-  BuildBuffer<PrimRef> refs(triangles.size());
+  BuildBuffer<PrimRef> refs(n);
   const RangeBounds all = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, triangles.size(), kGrain), RangeBounds{},
+      tbb::blocked_range<std::size_t>(0, n, kGrain), RangeBounds{},
       [&](const tbb::blocked_range<std::size_t>& r, RangeBounds b) {
         for (std::size_t i = r.begin(); i != r.end(); ++i)
-          b.extend(*std::construct_at(&refs[i], PrimRef{triangle_bounds(triangles[i]), static_cast<std::uint32_t>(i)}));
+          b.extend(*std::construct_at(&refs[i], PrimRef{bounds_of(i), static_cast<std::uint32_t>(i)}));
         return b;
       },
       [](RangeBounds a, const RangeBounds& b) {
         a.extend(b);
         return a;
       });
-  BuildBuffer<Bvh2Node> nodes(2 * triangles.size() - 1);  // at most: every leaf one triangle
+  BuildBuffer<Bvh2Node> nodes(2 * n - 1);  // at most: every leaf one primitive
   Builder builder(refs, nodes, options);
   builder.build(0, 0, refs.size(), all, 0);
   bvh.nodes.assign(nodes.data(), nodes.data() + builder.node_count());
@@ -316,6 +320,16 @@ Bvh2 build_bvh2_binned_sah(std::span<const Triangle> triangles, const Bvh2BuildO
     for (std::size_t i = r.begin(); i != r.end(); ++i) bvh.prim_ids[i] = refs[i].id;
   });
   return bvh;
+}
+
+}  // namespace
+
+Bvh2 build_bvh2_binned_sah(std::span<const Triangle> triangles, const Bvh2BuildOptions& options) {
+  return build_binned_sah(triangles.size(), [&](std::size_t i) { return triangle_bounds(triangles[i]); }, options);
+}
+
+Bvh2 build_bvh2_binned_sah(std::span<const BBox> prim_bounds, const Bvh2BuildOptions& options) {
+  return build_binned_sah(prim_bounds.size(), [&](std::size_t i) { return prim_bounds[i]; }, options);
 }
 
 double Bvh2::sah_cost(int leaf_granularity) const {

@@ -13,7 +13,8 @@ namespace raybench {
 
 BBox Scene::bounds() const {
   BBox b;
-  for (const Triangle& t : triangles) b.extend(triangle_bounds(t));
+  const PrimitiveSpans all = primitives();
+  for (std::size_t i = 0; i < all.size(); ++i) b.extend(all.bounds(i));
   return b;
 }
 
@@ -36,11 +37,22 @@ void check_scene_coordinates(const Scene& scene, const std::string& where) {
 std::uint64_t Scene::content_hash() const {
   // FNV-1a over the raw float bits: cheap, stable across runs and machines.
   std::uint64_t h = 0xcbf29ce484222325ull;
-  const auto* bytes = reinterpret_cast<const unsigned char*>(triangles.data());
-  const std::size_t n = triangles.size() * sizeof(Triangle);
-  for (std::size_t i = 0; i < n; ++i) {
-    h ^= bytes[i];
-    h *= 0x100000001b3ull;
+  const auto add = [&](const void* data, std::size_t n) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) {
+      h ^= bytes[i];
+      h *= 0x100000001b3ull;
+    }
+  };
+  add(triangles.data(), triangles.size() * sizeof(Triangle));
+  // A triangle-only scene hashes as before, so its stored ray sets stay valid;
+  // each analytic array adds its count first, so moving a primitive from one
+  // array to the next changes the hash.
+  if (has_analytic()) {
+    for (std::size_t n : {spheres.size(), boxes.size(), obbs.size()}) add(&n, sizeof n);
+    add(spheres.data(), spheres.size() * sizeof(Sphere));
+    add(boxes.data(), boxes.size() * sizeof(BBox));
+    add(obbs.data(), obbs.size() * sizeof(OrientedBox));
   }
   return h;
 }

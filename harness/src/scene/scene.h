@@ -1,10 +1,15 @@
-// A scene as every backend receives it: one flat array of triangles.
+// A scene as every backend receives it: one flat array of triangles and,
+// when its manifest names them (issue 31), analytic spheres, boxes and
+// oriented boxes.
 //
 // Order (documented in docs/scenes.md): the file's node hierarchy is
 // walked depth first, parent before children, children in file order; at each
 // node its meshes in the node's order; in each mesh its faces in file order,
 // polygons fan-triangulated by assimp. Node transforms are applied. Degenerate
 // triangles are kept. A triangle's index in this array is its `prim` id.
+// Analytic primitives follow the triangles in the one numbering of
+// raybench/prim/primitives.h: triangles, spheres, boxes, oriented boxes,
+// each in file order (PrimitiveSpans::kind and ::local map an id back).
 #pragma once
 
 #include <cstddef>
@@ -14,6 +19,7 @@
 #include <vector>
 
 #include "raybench/math/bbox.h"
+#include "raybench/prim/primitives.h"
 #include "raybench/prim/triangle.h"
 
 namespace raybench {
@@ -22,11 +28,18 @@ struct Scene {
   std::string name;    // short name used in results (file stem, or the manifest's name)
   std::string source;  // the path or procedural spec it was made from
   std::vector<Triangle> triangles;
+  std::vector<Sphere> spheres;      // analytic, after the triangles in prim ids
+  std::vector<BBox> boxes;          // analytic axis-aligned boxes, after the spheres
+  std::vector<OrientedBox> obbs;    // analytic oriented boxes, last
   std::size_t skipped_points = 0;  // point primitives in the file, not traced
   std::size_t skipped_lines = 0;   // line primitives in the file, not traced
 
-  BBox bounds() const;
-  // A hash of the triangle data: stored ray sets are keyed by it, so a changed
+  PrimitiveSpans primitives() const { return {triangles, spheres, boxes, obbs}; }
+  std::size_t primitive_count() const { return primitives().size(); }
+  bool has_analytic() const { return primitives().has_analytic(); }
+
+  BBox bounds() const;  // of every primitive
+  // A hash of all primitive data: stored ray sets are keyed by it, so a changed
   // mesh never reuses rays made for its old version.
   std::uint64_t content_hash() const;
 };

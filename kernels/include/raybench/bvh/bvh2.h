@@ -73,6 +73,12 @@ struct Bvh2BuildOptions {
 // Binned SAH, top-down, centroid binning on all three axes (bin_count bins).
 Bvh2 build_bvh2_binned_sah(std::span<const Triangle> triangles, const Bvh2BuildOptions& options = {});
 
+// The same builder over primitives of any kind given by their boxes
+// (raybench/prim/primitives.h: a scene with analytic primitives): leaf i of
+// prim_ids is an index into prim_bounds. Each primitive is in exactly one
+// leaf, whose box contains prim_bounds[i].
+Bvh2 build_bvh2_binned_sah(std::span<const BBox> prim_bounds, const Bvh2BuildOptions& options = {});
+
 // Full-sweep SAH, top-down: every object split between centroid-sorted
 // neighbours on all three axes is evaluated (bin_count is ignored). The
 // quality reference for the binned builder; O(n log n) sorting up front,
