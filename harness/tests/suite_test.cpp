@@ -511,6 +511,33 @@ TEST(Suite, PrimitiveKeysAreStringsNamingNpyFiles) {
   }
 }
 
+// Issue 31: "The default suite and the accuracy suite include an analytic scene."
+TEST(Suite, TheDefaultProceduralAndAccuracySuitesIncludeAnalyticScenes) {
+  const auto analytic = [](const char* manifest, const char* name) {
+    const Suite s = load_suite(std::string(RAYBENCH_SOURCE_DIR) + "/meshes/" + manifest);
+    const SuiteScene* entry = s.find(name);
+    return entry && entry->available() && load_suite_scene(*entry).has_analytic();
+  };
+  EXPECT_TRUE(analytic("default.toml", "terrain_spheres_analytic"));
+  EXPECT_TRUE(analytic("procedural.toml", "terrain_spheres_analytic"));
+  EXPECT_TRUE(analytic("procedural.toml", "terrain_spheres_analytic_small"));
+  EXPECT_TRUE(analytic("accuracy.toml", "analytic_mix"));
+  EXPECT_TRUE(analytic("accuracy.toml", "sphere_field"));
+  // The tessellated terrain stays beside its analytic twin, for comparison.
+  EXPECT_FALSE(analytic("default.toml", "terrain_spheres"));
+}
+
+// A camera or light inside a sphere would see (or be shadowed by) its inside only.
+TEST(Suite, TheSphereFieldsCameraAndLightStandOutsideEverySphere) {
+  const Suite s = load_suite(std::string(RAYBENCH_SOURCE_DIR) + "/meshes/accuracy.toml");
+  const SuiteScene* entry = s.find("sphere_field");
+  ASSERT_TRUE(entry && entry->camera && entry->light);
+  for (const Sphere& b : load_suite_scene(*entry).spheres) {
+    EXPECT_GT(length(entry->camera->position - b.center), b.radius);
+    EXPECT_GT(length(*entry->light - b.center), b.radius);
+  }
+}
+
 // --- The results table (suite/results_table.h).
 
 ResultRow timed_row(double min, double median, double max) {
