@@ -528,7 +528,7 @@ TEST(Suite, TheDefaultProceduralAndAccuracySuitesIncludeAnalyticScenes) {
 }
 
 // A camera or light inside a sphere would see (or be shadowed by) its inside only.
-TEST(Suite, TheSphereFieldsCameraAndLightStandOutsideEverySphere) {
+TEST(Suite, TheAnalyticScenesCamerasAndLightsStandOutsideEveryPrimitive) {
   const Suite s = load_suite(std::string(RAYBENCH_SOURCE_DIR) + "/meshes/accuracy.toml");
   const SuiteScene* entry = s.find("sphere_field");
   ASSERT_TRUE(entry && entry->camera && entry->light);
@@ -536,6 +536,12 @@ TEST(Suite, TheSphereFieldsCameraAndLightStandOutsideEverySphere) {
     EXPECT_GT(length(entry->camera->position - b.center), b.radius);
     EXPECT_GT(length(*entry->light - b.center), b.radius);
   }
+  // The mix's camera and light stand above all of it.
+  const SuiteScene* mix = s.find("analytic_mix");
+  ASSERT_TRUE(mix && mix->camera && mix->light);
+  const float top = load_suite_scene(*mix).bounds().upper.y;
+  EXPECT_GT(mix->camera->position.y, top);
+  EXPECT_GT(mix->light->y, top);
 }
 
 // --- The results table (suite/results_table.h).
