@@ -229,12 +229,12 @@ Scene load_suite_scene(const SuiteScene& entry) {
     throw InputError("scene '" + entry.name + "' (" + entry.sources() + ")",
                      "holds no primitives (its files have 0 rows): nothing to trace");
   if (entry.transformed()) {
-    const double s = entry.scale;
     for (Triangle& t : scene.triangles) {
-      t.v0 = moved(t.v0, s, entry.offset);
-      t.v1 = moved(t.v1, s, entry.offset);
-      t.v2 = moved(t.v2, s, entry.offset);
+      t.v0 = moved(t.v0, entry.scale, entry.offset);
+      t.v1 = moved(t.v1, entry.scale, entry.offset);
+      t.v2 = moved(t.v2, entry.scale, entry.offset);
     }
+    const double s = entry.scale;
     for (Sphere& b : scene.spheres) {
       b.center = moved(b.center, s, entry.offset);
       b.radius = static_cast<float>(s * b.radius);
