@@ -122,10 +122,24 @@ Candidate judge_candidate(const PrimitiveSpans& prims, const Ray& ray, std::size
   return {};
 }
 
-// Every primitive's box, in prim id order, for the tree of a scene with analytic primitives.
+// Every primitive's box, in prim id order, for the tree of a scene with
+// analytic primitives; grown by twice the ambiguity band of the primitive's
+// largest extent (and rounded outward), so that a ray passing just outside a
+// primitive still reaches its leaf and is flagged as a near miss: an
+// analytic primitive's box is tight (a box's is the box itself), and a ray
+// grazing its edge would otherwise be culled before the band is looked at.
 std::vector<BBox> primitive_bounds(const PrimitiveSpans& prims) {
   std::vector<BBox> bounds(prims.size());
-  for (std::size_t id = 0; id < bounds.size(); ++id) bounds[id] = prims.bounds(id);
+  for (std::size_t id = 0; id < bounds.size(); ++id) {
+    BBox b = prims.bounds(id);
+    const Vec3f e = b.extent();
+    const float grow = static_cast<float>(2.0 * kAmbiguityBand) * std::max({e.x, e.y, e.z});
+    for (int a = 0; a < 3; ++a) {
+      b.lower[a] = std::nextafter(b.lower[a] - grow, -std::numeric_limits<float>::infinity());
+      b.upper[a] = std::nextafter(b.upper[a] + grow, std::numeric_limits<float>::infinity());
+    }
+    bounds[id] = b;
+  }
   return bounds;
 }
 
