@@ -552,7 +552,7 @@ int run(int argc, char** argv) {
                  rays.size(), trace_out);
     } else {
       const std::vector<Hit> h = executor.answers(*backend, screened);
-      require_valid_hits(*backend, h, s.scene.triangles.size(), fmt::format("{} ({})", s.scene.name, trace_rays));
+      require_valid_hits(*backend, h, s.scene.primitive_count(), fmt::format("{} ({})", s.scene.name, trace_rays));
       std::vector<double> out(rays.size() * 4);
       for (std::size_t i = 0; i < h.size(); ++i) {
         out[4 * i + 0] = h[i].t;

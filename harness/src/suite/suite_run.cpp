@@ -232,7 +232,7 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
         // the referee judges them against the rays as stored.
         if (query_of(rs.kind) == Query::kIntersect) {
           const std::vector<Hit> hits = executor.answers(*backend, rs.screened);
-          require_valid_hits(*backend, hits, scene.triangles.size(), scene.name + "/" + row.rayset);
+          require_valid_hits(*backend, hits, scene.primitive_count(), scene.name + "/" + row.rayset);
           a = compare_hits(hits, ref_hits[r], rs.screened.rays, scene.triangles);
           if (accuracy) judge_hits(*referee, rs.rays, rs.truth, hits, rs.sources, *accuracy);
         } else {
