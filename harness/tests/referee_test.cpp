@@ -9,6 +9,11 @@
 #include <gtest/gtest.h>
 
 #include "backends/backend.h"
+#include "raybench/prim/aabb_slab.h"
+#include "raybench/prim/analytic_hit.h"
+#include "raybench/prim/obb_eigen.h"
+#include "raybench/prim/sphere_precise.h"
+#include "raybench/prim/triangle_watertight.h"
 #include "scene/random.h"
 #include "rays/rayset.h"
 #include "referee/exact_primitives.h"
@@ -530,6 +535,55 @@ TEST(RefereeAnalytic, AnalyticOnlySceneAndTheReferenceBackend) {
   std::vector<std::uint8_t> occluded(rays.size());
   reference->occluded(rays, occluded);
   EXPECT_EQ(occluded, (std::vector<std::uint8_t>{1, 1, 0}));
+}
+
+
+TEST(RefereeAnalytic, OurSurfaceTestsAgreeWithItOnEveryUnambiguousRay) {
+  // The referee's semantics are the kernels' (prim/analytic_hit.h): brute
+  // force with the float tests (watertight triangles, SpherePrecise, Slab,
+  // Obb) answers every unambiguous ray as the referee does.
+  const Scene s = mixed_scene();
+  const Referee referee(s);
+  const PrimitiveSpans prims = s.primitives();
+  std::size_t unambiguous = 0, hit_disagree = 0, prim_disagree = 0;
+  for (std::uint64_t i = 0; i < 4000; ++i) {
+    Rng rng(11, 0, i);
+    const auto in = [&](float lo, float hi) { return lo + static_cast<float>(rng.next_double()) * (hi - lo); };
+    const double z = 2.0 * rng.next_double() - 1.0, phi = 6.283185307179586 * rng.next_double(), q = std::sqrt(1.0 - z * z);
+    const Ray r = ray_from({in(-7, 7), in(-1, 6), in(-7, 7)},
+                           {static_cast<float>(q * std::cos(phi)), static_cast<float>(z), static_cast<float>(q * std::sin(phi))});
+    const Slab::Precomputed slab = Slab::precompute(r);
+    float tmax = r.tfar;
+    std::int32_t prim = kNoHit;
+    for (std::size_t id = 0; id < prims.size(); ++id) {
+      const std::size_t k = prims.local(id);
+      float t = 0.0f;
+      bool found = false;
+      switch (prims.kind(id)) {
+        case PrimitiveKind::kTriangle: {
+          TriangleHit th;
+          found = WatertightTriangle::intersect(r, tmax, s.triangles[k], th);
+          t = th.t;
+          break;
+        }
+        case PrimitiveKind::kSphere: found = intersect_sphere_surface<SpherePrecise>(r, tmax, s.spheres[k], t); break;
+        case PrimitiveKind::kBox: found = intersect_box_surface<Slab>(slab, r, tmax, s.boxes[k], t); break;
+        case PrimitiveKind::kOrientedBox: found = intersect_obb_surface<Obb>(r, tmax, s.obbs[k], t); break;
+      }
+      if (found) {
+        tmax = t;
+        prim = static_cast<std::int32_t>(id);
+      }
+    }
+    const RefereeVerdict v = referee.judge(r);
+    if (v.ambiguous) continue;
+    ++unambiguous;
+    hit_disagree += v.hit() != (prim != kNoHit);
+    prim_disagree += v.hit() && prim != kNoHit && !referee.accepts(r, v, prim);
+  }
+  EXPECT_GT(unambiguous, 3900u);
+  EXPECT_EQ(hit_disagree, 0u);
+  EXPECT_EQ(prim_disagree, 0u);
 }
 
 }  // namespace
