@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <vector>
 
 #include "raybench/bvh/bvh2.h"
 #include "raybench/math/ray.h"
@@ -61,10 +62,13 @@ class Referee {
   bool accepts(const Ray& ray, const RefereeVerdict& verdict, std::int32_t prim) const;
 
   const Scene& scene() const { return scene_; }
-  std::size_t memory_bytes() const { return bvh_.memory_bytes(); }
+  std::size_t memory_bytes() const { return bvh_.memory_bytes() + bounds_.size() * sizeof(BBox); }
 
  private:
   const Scene& scene_;
+  // With analytic primitives: every primitive's box grown by the ambiguity
+  // band (referee.cpp), in prim id order; the tree is built over them.
+  std::vector<BBox> bounds_;
   Bvh2 bvh_;
 };
 
