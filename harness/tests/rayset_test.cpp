@@ -8,6 +8,7 @@
 #include <set>
 
 #include "io/error.h"
+#include "rays/analytic_targets.h"
 #include "raybench/bvh/bvh2_traverse.h"
 #include "referee/referee.h"
 #include "scene/random.h"
@@ -489,6 +490,90 @@ TEST(AnalyticRaySets, BoxCornersAndEdgesAreAimedAtExactly) {
     ambiguous += v.ambiguous;
   }
   EXPECT_GT(ambiguous, 300u);
+}
+
+
+TEST(AnalyticTargets, TheNearestSurfacePointIsOnAFaceTheRayCanHaveCrossed) {
+  Scene s;
+  s.name = "targets";
+  s.spheres = {{{0, 0, 5}, 2.0f}};
+  s.boxes = {{{0, 0, 0}, {1, 1, 1}}};
+  const PrimitiveSpans prims = s.primitives();
+  // A sphere hit point off the surface by rounding: projected radially.
+  SurfacePoint sp = nearest_surface_point(prims, 0, {0, 2.0000001, 5}, {0, 10, 5}, {0, -1, 0});
+  EXPECT_NEAR(sp.point.y(), 2.0, 1e-15);
+  EXPECT_NEAR(sp.normal.y(), 1.0, 1e-15);
+  // Sliding along the box's top plane into its -x face: p rounded to just
+  // above the top (nearer the +y plane), but only the -x face can have been crossed.
+  sp = nearest_surface_point(prims, 1, {-1e-8, 1 + 1e-9, 0.5}, {-1, 1, 0.5}, {1, 0, 0});
+  EXPECT_EQ(sp.normal, Eigen::Vector3d(-1, 0, 0));
+  EXPECT_EQ(sp.point, Eigen::Vector3d(0, 1, 0.5));
+  // From inside, out through the +x face at its top edge.
+  sp = nearest_surface_point(prims, 1, {1 + 1e-8, 1 - 1e-10, 0.5}, {0.5, 1, 0.5}, {1, 0, 0});
+  EXPECT_EQ(sp.normal, Eigen::Vector3d(1, 0, 0));
+  EXPECT_EQ(sp.point.x(), 1.0);  // moved onto the face's plane; within the face, unchanged
+  EXPECT_EQ(sp.point.y(), 1 - 1e-10);
+  // Away from edges the nearest face wins whatever the direction.
+  sp = nearest_surface_point(prims, 1, {0.5, 1 + 1e-7, 0.5}, {0.5, 3, 0.5}, {0, -1, 0});
+  EXPECT_EQ(sp.normal, Eigen::Vector3d(0, 1, 0));
+}
+
+TEST(AnalyticTargets, SurfacePointsCornersAndEdgesLieWhereTheySay) {
+  Scene s;
+  s.name = "targets";
+  s.spheres = {{{1, 2, 3}, 0.5f}};
+  s.boxes = {{{-1, 0.5f, 2}, {3, 1.25f, 2.5f}}};
+  OrientedBox o;
+  o.center = {5, 5, 5};
+  o.axis[0] = {0.6f, 0.8f, 0};
+  o.axis[1] = {-0.8f, 0.6f, 0};
+  o.axis[2] = {0, 0, 1};
+  o.half_extent = {1, 2, 0.5f};
+  s.obbs = {o};
+  const PrimitiveSpans prims = s.primitives();
+  const BBox& b = s.boxes[0];
+  for (std::uint64_t i = 0; i < 200; ++i) {
+    Rng rng(1, 2, i);
+    // On the sphere, normal radial.
+    SurfacePoint p = random_surface_point(prims, 0, rng, 0.1);
+    EXPECT_NEAR((p.point - Eigen::Vector3d(1, 2, 3)).norm(), 0.5, 1e-12);
+    EXPECT_NEAR((p.point - Eigen::Vector3d(1, 2, 3)).normalized().dot(p.normal), 1.0, 1e-12);
+    // On a face of the box, 10 % inside its edges, the normal that face's.
+    p = random_surface_point(prims, 1, rng, 0.1);
+    int on_planes = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = b.lower[a], hi = b.upper[a], margin = 0.1 * (hi - lo) * (1 - 1e-9);
+      const bool on = p.point[a] == lo || p.point[a] == hi;
+      on_planes += on;
+      if (on) {
+        EXPECT_EQ(p.normal[a], p.point[a] == hi ? 1.0 : -1.0);
+      } else {
+        EXPECT_GE(p.point[a], lo + margin);
+        EXPECT_LE(p.point[a], hi - margin);
+      }
+    }
+    EXPECT_EQ(on_planes, 1);
+    // A corner of the box is made of its own floats; an edge point has two.
+    const Vec3f c = random_corner(prims, 1, rng);
+    const Vec3f e = random_edge_point(prims, 1, rng);
+    int corner_planes = 0, edge_planes = 0;
+    for (int a = 0; a < 3; ++a) {
+      corner_planes += c[a] == b.lower[a] || c[a] == b.upper[a];
+      edge_planes += e[a] == b.lower[a] || e[a] == b.upper[a];
+      EXPECT_GE(e[a], b.lower[a]);
+      EXPECT_LE(e[a], b.upper[a]);
+    }
+    EXPECT_EQ(corner_planes, 3);
+    EXPECT_GE(edge_planes, 2);
+    // The OBB's surface points lie on one of its faces (in its frame).
+    p = random_surface_point(prims, 2, rng, 0.0);
+    const Eigen::Vector3d q = p.point - Eigen::Vector3d(5, 5, 5);
+    const double ex[3] = {std::fabs(q.dot(Eigen::Vector3d(0.6, 0.8, 0))) - 1, std::fabs(q.dot(Eigen::Vector3d(-0.8, 0.6, 0))) - 2,
+                          std::fabs(q.z()) - 0.5};
+    EXPECT_NEAR(std::max({ex[0], ex[1], ex[2]}), 0.0, 1e-6);
+  }
+  EXPECT_DOUBLE_EQ(primitive_size(prims, 0), 1.0);
+  EXPECT_NEAR(primitive_size(prims, 1), std::sqrt(16.0 + 0.5625 + 0.25), 1e-12);
 }
 
 }  // namespace

@@ -63,7 +63,8 @@ Eigen::Vector3d uniform_direction(Rng& rng) {
 
 }  // namespace
 
-SurfacePoint nearest_surface_point(const PrimitiveSpans& prims, std::size_t id, const Eigen::Vector3d& p) {
+SurfacePoint nearest_surface_point(const PrimitiveSpans& prims, std::size_t id, const Eigen::Vector3d& p,
+                                   const Eigen::Vector3d& org, const Eigen::Vector3d& dir) {
   if (prims.kind(id) == PrimitiveKind::kSphere) {
     const Sphere& s = prims.spheres[prims.local(id)];
     const Eigen::Vector3d c = to_eigen(s.center), q = p - c;
@@ -72,11 +73,17 @@ SurfacePoint nearest_surface_point(const PrimitiveSpans& prims, std::size_t id, 
   }
   const Frame f = frame_of(prims, id);
   Eigen::Vector3d e = f.local(p);
-  // The face whose plane is nearest: |e_a| closest to h_a.
+  const Eigen::Vector3d o = f.local(org);
+  const bool entering = (o.cwiseAbs() - f.half).maxCoeff() > 0.0;
+  // The face whose plane is nearest (|e_a| closest to h_a), preferring,
+  // within 1e-6 of the box's size, one the ray can have crossed.
+  const double tie = 1e-6 * f.half.norm();
   int face = 0;
   double best = std::numeric_limits<double>::infinity();
   for (int a = 0; a < 3; ++a) {
-    const double gap = std::fabs(std::fabs(e[a]) - f.half[a]);
+    const double toward = (std::signbit(e[a]) ? -1.0 : 1.0) * f.axis[a].dot(dir);  // outward normal . dir
+    const bool crossable = entering ? toward < 0.0 : toward > 0.0;
+    const double gap = std::fabs(std::fabs(e[a]) - f.half[a]) + (crossable ? 0.0 : tie);
     if (gap < best) best = gap, face = a;
   }
   const double side = std::signbit(e[face]) ? -1.0 : 1.0;

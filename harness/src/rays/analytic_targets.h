@@ -24,11 +24,15 @@ struct SurfacePoint {
 
 // `id` must name an analytic primitive of `prims` (not a triangle).
 
-// The surface point nearest `p` (a hit point computed as o + t d, off the
-// surface by the rounding of t) and the outward normal there: a sphere's
-// radial projection; a box's or OBB's nearest face, the point moved onto
-// its plane and clamped into the face.
-SurfacePoint nearest_surface_point(const PrimitiveSpans& prims, std::size_t id, const Eigen::Vector3d& p);
+// The surface point nearest `p`, the hit of the ray (org, dir) computed as
+// org + t dir (off the surface by the rounding of t), and the outward normal
+// there: a sphere's radial projection; a box's or OBB's nearest face, the
+// point moved onto its plane and clamped into the face. Near an edge, where
+// two faces' planes are within 1e-6 of the box's size, the face the ray can
+// have crossed wins: one it enters (normal against dir) when org lies
+// outside, one it leaves when org lies inside.
+SurfacePoint nearest_surface_point(const PrimitiveSpans& prims, std::size_t id, const Eigen::Vector3d& p,
+                                   const Eigen::Vector3d& org, const Eigen::Vector3d& dir);
 
 // A random point of the surface: a sphere's uniformly; a box's or OBB's on
 // a face chosen by area, each face coordinate at least `margin` (a fraction

@@ -284,8 +284,9 @@ std::vector<Ray> RayGenerator::from_primary_hits(const RaySetSpec& spec, const C
         // An analytic hit: org + t dir moved onto the surface (t's rounding
         // would otherwise leave it off by more than the offset below), and
         // the outward normal there.
-        const SurfacePoint s = nearest_surface_point(scene_.primitives(), static_cast<std::size_t>(hit.prim),
-                                                     to_eigen(primary.org) + static_cast<double>(hit.t) * to_eigen(primary.dir));
+        const Eigen::Vector3d org = to_eigen(primary.org), dir = to_eigen(primary.dir);
+        const SurfacePoint s =
+            nearest_surface_point(scene_.primitives(), static_cast<std::size_t>(hit.prim), org + static_cast<double>(hit.t) * dir, org, dir);
         p = s.point;
         n = s.normal;
       }
