@@ -247,9 +247,17 @@ bool Referee::accepts(const Ray& ray, const RefereeVerdict& verdict, std::int32_
     const Triangle& tri = prims.triangles[id];
     return exact_intersect(ray, tri, TValue::kEnclosed).hit && same_exact_t(ray, tri, prims.triangles[winner]);
   }
+  return same_t(ray, prims, id, winner);
+}
+
+bool same_t(const Ray& ray, const PrimitiveSpans& prims, std::size_t a, std::size_t b) {
+  if (a >= prims.size() || b >= prims.size()) return false;
+  if (prims.kind(a) == PrimitiveKind::kTriangle && prims.kind(b) == PrimitiveKind::kTriangle)
+    return same_exact_t(ray, prims.triangles[a], prims.triangles[b]);
+  if (!is_traceable(ray)) return false;
   const double lo = std::max(static_cast<double>(ray.tnear), 0.0);
-  const Candidate a = judge_candidate(prims, ray, id, lo), b = judge_candidate(prims, ray, winner, lo);
-  return a.hit && b.hit && a.t_lower <= b.t_upper && b.t_lower <= a.t_upper;
+  const Candidate ha = judge_candidate(prims, ray, a, lo), hb = judge_candidate(prims, ray, b, lo);
+  return ha.hit && hb.hit && ha.t_lower <= hb.t_upper && hb.t_lower <= ha.t_upper;
 }
 
 }  // namespace raybench

@@ -49,6 +49,12 @@ struct RefereeVerdict {
   bool hit() const { return prim != kNoHit; }
 };
 
+// Whether the ray hits primitives a and b (global ids of `prims`) at the
+// same t as the referee ties hits (above): two triangles whose planes the
+// ray's line crosses at exactly the same t (same_exact_t; no hit needed);
+// otherwise both hit, their enclosures of the exact t overlapping.
+bool same_t(const Ray& ray, const PrimitiveSpans& prims, std::size_t a, std::size_t b);
+
 class Referee {
  public:
   // Keeps a reference to the scene: it must outlive the referee.
