@@ -434,6 +434,35 @@ TEST(AnalyticRaySets, SecondaryRaysStartOnTheirSourceAndNeverHitItAgain) {
   }
 }
 
+TEST(AnalyticRaySets, FromInsideASphereSecondaryRaysLeaveItsInnerSurfaceInward) {
+  // The camera inside a sphere (a sky dome) with a box in it: primary rays
+  // hit the dome from inside (its exit), and diffuse rays start just inside it.
+  Scene dome;
+  dome.name = "dome";
+  dome.spheres = {{{0, 0, 0}, 50.0f}};
+  dome.boxes = {{{-1, -1, -1}, {1, 1, 1}}};
+  Camera camera;
+  camera.position = {0, 0, 10};
+  camera.look_at = {0, 0, 0};
+  const RayGenerator gen(dome);
+  const Referee referee(dome);
+  std::vector<std::int32_t> sources;
+  const std::vector<Ray> rays = gen.generate({RaySetKind::kDiffuse, 1000, 1, camera, std::nullopt}, &sources);
+  std::size_t from_dome = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (sources[i] != 0) continue;
+    ++from_dome;
+    const double r = length(rays[i].org);
+    EXPECT_LT(r, 50.0);
+    EXPECT_GT(r, 50.0 - 1e-3);
+    // Inward, so it meets the dome (or the box) again at a real distance.
+    const RefereeVerdict v = referee.judge(rays[i]);
+    ASSERT_TRUE(v.hit());
+    EXPECT_GT(v.t, 1e-3);
+  }
+  EXPECT_GT(from_dome, 500u);
+}
+
 TEST(AnalyticRaySets, AimedSetsHitTheirTargetsGrazingBecomesTangentBehindOriginMisses) {
   Scene one;
   one.name = "one sphere";
