@@ -233,7 +233,7 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
         if (query_of(rs.kind) == Query::kIntersect) {
           const std::vector<Hit> hits = executor.answers(*backend, rs.screened);
           require_valid_hits(*backend, hits, scene.primitive_count(), scene.name + "/" + row.rayset);
-          a = compare_hits(hits, ref_hits[r], rs.screened.rays, scene.triangles);
+          a = compare_hits(hits, ref_hits[r], rs.screened.rays, scene.primitives());
           if (accuracy) judge_hits(*referee, rs.rays, rs.truth, hits, rs.sources, *accuracy);
         } else {
           const std::vector<std::uint8_t> occ = executor.occlusion_answers(*backend, rs.screened);
