@@ -99,10 +99,33 @@ struct UserGeometry<OrientedBox> {
   }
 };
 
+// The box Embree's BVH gets: the primitive's, widened on every side by 1e-6
+// of its largest coordinate magnitude or extent, and one float ulp.
+// - Embree's node test replaces 1/0 by a large finite number (rcp_safe), so a
+//   ray lying exactly in a box's far plane, with a zero component across it,
+//   gets the far distance 0 * large = 0 on that axis and is culled before our
+//   test, which keeps it (closed box; Slab reads 0 * inf = NaN as no
+//   constraint). One ulp outward makes that distance positive.
+// - Its distances are plane * (1/d) - org * (1/d) with an approximate 1/d
+//   (rcp and one Newton step), off from our Slab's by some ulps of the
+//   coordinates and of t, so a ray through an edge or a corner can pass ours
+//   and fail Embree's. RTC_SCENE_FLAG_ROBUST does not help: Embree 3.13 has
+//   no robust traversal for user geometry (bvh4_factory.cpp lists only
+//   BVH4VirtualIntersector1). The 1e-6 covers rays from within about the
+//   box's own magnitude; from much further, an edge hit can still be culled
+//   (rates in harness/tests/embree_analytic_test.cpp, EdgesAndCorners).
+// Culling only: the callback decides every hit on the primitive itself.
 template <typename Prim>
 void user_bounds(const RTCBoundsFunctionArguments* args) {
   const BBox b = UserGeometry<Prim>::bounds(static_cast<const Prim*>(args->geometryUserPtr)[args->primID]);
-  *args->bounds_o = {b.lower.x, b.lower.y, b.lower.z, 0.0f, b.upper.x, b.upper.y, b.upper.z, 0.0f};
+  float scale = 0.0f;
+  for (int a = 0; a < 3; ++a)
+    scale = std::max({scale, std::fabs(b.lower[a]), std::fabs(b.upper[a]), b.upper[a] - b.lower[a]});
+  const float pad = scale * 1e-6f;
+  const auto down = [&](float x) { return std::nextafter(x - pad, -std::numeric_limits<float>::infinity()); };
+  const auto up = [&](float x) { return std::nextafter(x + pad, std::numeric_limits<float>::infinity()); };
+  *args->bounds_o = {down(b.lower.x), down(b.lower.y), down(b.lower.z), 0.0f,
+                     up(b.upper.x),   up(b.upper.y),   up(b.upper.z),   0.0f};
 }
 
 // The ray as Embree holds it (tnear >= 0 already: fill() raised it), its
