@@ -539,6 +539,9 @@ int run(int argc, char** argv) {
     const ScreenedRays screened = screen_rays(read_ray_file(trace_rays));
     const std::vector<Ray>& rays = screened.rays;
     const SceneArg s = resolve_scene(trace_scene, suite);
+    // A run skips such a pair with a note; tracing one explicitly is bad usage.
+    if (const std::string problem = capability_problem(*backend, s.scene); !problem.empty())
+      throw InputError("--backend", problem + " (raybench run skips such a pair)");
     const TraceExecutor executor(threads);
     executor.run([&] { backend->build(s.scene); });
     std::size_t hits = 0;
@@ -552,7 +555,7 @@ int run(int argc, char** argv) {
                  rays.size(), trace_out);
     } else {
       const std::vector<Hit> h = executor.answers(*backend, screened);
-      require_valid_hits(*backend, h, s.scene.triangles.size(), fmt::format("{} ({})", s.scene.name, trace_rays));
+      require_valid_hits(*backend, h, s.scene.primitive_count(), fmt::format("{} ({})", s.scene.name, trace_rays));
       std::vector<double> out(rays.size() * 4);
       for (std::size_t i = 0; i < h.size(); ++i) {
         out[4 * i + 0] = h[i].t;
