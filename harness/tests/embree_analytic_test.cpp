@@ -297,7 +297,9 @@ TEST(EmbreeSpheres, TangentRaysHitAndOneUlpAsideDecidesAsTheReferee) {
     SCOPED_TRACE(y);
     EXPECT_EQ(theirs.hit(), exact.hit);
     EXPECT_EQ(ours.hit(), exact.hit);
-    if (exact.hit) EXPECT_FLOAT_EQ(theirs.t, static_cast<float>(exact.t));
+    if (exact.hit) {
+      EXPECT_FLOAT_EQ(theirs.t, static_cast<float>(exact.t));
+    }
   }
   EXPECT_TRUE(exact_surface(Ray{{-7, 5.5f, -2}, 0.0f, {1, 0, 0}, kInf}, scene.spheres[0]).hit);
 }
@@ -696,7 +698,9 @@ TEST(EmbreeBoxes, EntryFromOutsideExitFromInsideAndFaces) {
   const auto expect = [&](const Ray& ray, std::int32_t prim, float t) {
     const Hit hit = trace(*embree, ray);
     EXPECT_EQ(hit.prim, prim);
-    if (prim != kNoHit) EXPECT_FLOAT_EQ(hit.t, t);
+    if (prim != kNoHit) {
+      EXPECT_FLOAT_EQ(hit.t, t);
+    }
     EXPECT_EQ(hit.u, 0.0f);
     EXPECT_EQ(hit.v, 0.0f);
     EXPECT_EQ(occluded(*embree, ray), prim != kNoHit);

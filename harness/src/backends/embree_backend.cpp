@@ -17,7 +17,10 @@
 //     ch. 7), and l^2 <= r^2 hits: a tangent ray hits (closed), and a far
 //     ray's hit/miss does not suffer the textbook discriminant's cancellation;
 //     1/(d.d) is Embree's rcp (an approximation refined by one Newton step),
-//     so t differs from ours in its last bits;
+//     so t differs from ours in its last bits; the near root is projection
+//     - half chord, which cancels when the origin is close to the surface
+//     of a big sphere (t then right to some ulps of r, not of t: so is ours,
+//     whose |f|^2 - r^2 loses the same digits);
 //   * the interval is closed at tnear ([tnear, tfar]), ours is open: a ray
 //     starting exactly on the surface hits it at t ~ 0 in Embree (pointing
 //     in or out), where raybench's semantics say the exit (pointing in) or a
@@ -36,8 +39,10 @@
 // - Boxes and oriented boxes: RTC_GEOMETRY_TYPE_USER, with bounds, intersect
 //   and occluded callbacks that run our scalar scene-level tests
 //   (analytic_hit.h: Slab for boxes, Obb for oriented boxes), so their
-//   answers are our kernels' behind Embree's BVH over the bounds; the cost
-//   of a callback per candidate is part of what this backend measures.
+//   answers are our kernels' behind Embree's BVH over the bounds (widened:
+//   see user_bounds; RTC_SCENE_FLAG_ROBUST does not reach user geometry);
+//   the cost of a callback per candidate is part of what this backend
+//   measures.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
