@@ -118,7 +118,7 @@ struct UserGeometry<OrientedBox> {
 //   no robust traversal for user geometry (bvh4_factory.cpp lists only
 //   BVH4VirtualIntersector1). The 1e-6 covers rays from within about the
 //   box's own magnitude; from much further, an edge hit can still be culled
-//   (rates in harness/tests/embree_analytic_test.cpp, EdgesAndCorners).
+//   (embree_analytic_test.cpp, KnownLimit_EdgesAndCornersFromFarAwayCanBeCulled).
 // Culling only: the callback decides every hit on the primitive itself.
 template <typename Prim>
 void user_bounds(const RTCBoundsFunctionArguments* args) {
