@@ -23,7 +23,6 @@
 #include "raybench/prim/triangle_mt.h"
 #include "rays/screening.h"
 #include "referee/exact_primitives.h"
-#include "referee/exact_triangle.h"
 #include "scene/scene.h"
 #include "suite/suite_run.h"
 #include "test_util.h"
@@ -148,7 +147,6 @@ Scene sphere_field(const Vec3f& offset, std::uint32_t seed = 1) {
   std::mt19937 rng(seed);
   Scene s;
   s.name = "sphere_field";
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   for (int i = 0; i < 40; ++i) {
     const float distance = log_uniform(rng, 1.0f, 1e4f);
     s.spheres.push_back({offset + random_unit(rng) * distance, log_uniform(rng, 1e-4f, 0.3f * distance)});
@@ -175,8 +173,8 @@ void random_axes(std::mt19937& rng, Vec3f axes[3]) {
     axes[a] = {static_cast<float>(m[0][a]), static_cast<float>(m[1][a]), static_cast<float>(m[2][a])};
 }
 
-// Boxes and oriented boxes of size 1e-3 to 1e2, scattered over +-100,
-// some overlapping, moved by `offset`.
+// 30 boxes and 30 oriented boxes of half extents 1e-3 to 30, scattered over
+// +-100, some overlapping, moved by `offset`.
 Scene box_field(const Vec3f& offset, std::uint32_t seed = 2) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(-100.0f, 100.0f);
@@ -215,9 +213,11 @@ Vec3f surface_point(const Scene& scene, std::size_t id, std::mt19937& rng, bool 
     }
     case PrimitiveKind::kBox: {
       const BBox& b = scene.boxes[i];
-      Vec3f p;
-      for (int k = 0; k < 3; ++k) p[k] = s[k] < 0 ? (s[k] == -1.0f ? b.lower[k] : b.lower[k] + (b.upper[k] - b.lower[k]) * (s[k] + 1) / 2)
-                                                  : (s[k] == 1.0f ? b.upper[k] : b.lower[k] + (b.upper[k] - b.lower[k]) * (s[k] + 1) / 2);
+      Vec3f p;  // the face's own coordinate exactly, the others between
+      for (int k = 0; k < 3; ++k)
+        p[k] = s[k] == -1.0f  ? b.lower[k]
+               : s[k] == 1.0f ? b.upper[k]
+                              : b.lower[k] + (b.upper[k] - b.lower[k]) * (s[k] + 1) / 2;
       return p;
     }
     case PrimitiveKind::kOrientedBox: {
@@ -231,8 +231,8 @@ Vec3f surface_point(const Scene& scene, std::size_t id, std::mt19937& rng, bool 
   return {};
 }
 
-// Rays aimed at random analytic primitives from random origins up to
-// `reach` away (and a few from inside every primitive's box).
+// Rays aimed at points on random analytic primitives (surface_point) from
+// random directions, 1e-2 to `reach` away.
 std::vector<Ray> aimed_rays(const Scene& scene, std::size_t n, float reach, bool edges, std::uint32_t seed) {
   std::mt19937 rng(seed);
   const PrimitiveSpans prims = scene.primitives();
