@@ -425,8 +425,8 @@ RunResults run_suite(const RunOptions& options) {
   if (options.scenes.empty()) {
     for (const SuiteScene& s : options.suite.scenes) {
       if (s.available()) chosen.push_back(choose_scene(s.name, options.suite));
-      else if (!s.optional) throw InputError(options.suite.path, fmt::format("scene '{}': {} not found (add optional = true to skip it when absent)", s.name, s.path));
-      else progress(fmt::format("skipping scene '{}': {} not found", s.name, s.path));
+      else if (!s.optional) throw InputError(options.suite.path, fmt::format("scene '{}': {} not found (add optional = true to skip it when absent)", s.name, s.missing()));
+      else progress(fmt::format("skipping scene '{}': {} not found", s.name, s.missing()));
     }
     if (chosen.empty()) throw InputError(options.suite.path, "no scene of the suite is available");
   }
@@ -436,7 +436,7 @@ RunResults run_suite(const RunOptions& options) {
     progress(fmt::format("[{}/{}] loading {}", i + 1, chosen.size(), chosen[i].arg));
     scenes.push_back({chosen[i], load_chosen_scene(chosen[i])});
     const Scene& s = scenes.back().scene;
-    progress(fmt::format("  {} triangles{}", s.triangles.size(),
+    progress(fmt::format("  {}{}", describe_primitives(s),
                          s.skipped_points + s.skipped_lines
                              ? fmt::format(" ({} points and {} lines skipped)", s.skipped_points, s.skipped_lines)
                              : ""));
