@@ -543,6 +543,9 @@ int run(int argc, char** argv) {
     const ScreenedRays screened = screen_rays(read_ray_file(trace_rays));
     const std::vector<Ray>& rays = screened.rays;
     const SceneArg s = resolve_scene(trace_scene, suite);
+    // A run skips such a pair with a note; tracing one explicitly is bad usage.
+    if (const std::string problem = capability_problem(*backend, s.scene); !problem.empty())
+      throw InputError("--backend", problem + " (raybench run skips such a pair)");
     const TraceExecutor executor(threads);
     executor.run([&] { backend->build(s.scene); });
     std::size_t hits = 0;

@@ -87,6 +87,7 @@ struct SceneResults {
   std::vector<ResultRow> rows;
   std::vector<AccuracyRow> accuracy;  // runs with RunOptions::accuracy_csv only
   std::optional<CameraCoverage> camera;  // runs with the primary ray set
+  std::vector<SkippedBackend> skipped;
 };
 
 // The seed of a scene's round orders: the run's seed and the scene's name,
@@ -96,10 +97,10 @@ std::uint64_t round_seed(std::uint64_t seed, const std::string& scene) {
 }
 
 // One scene, scene `index` of `count`: its ray sets (made or reused) and
-// screened, the referee's verdicts (accuracy runs), every backend built,
-// agreement with Embree, the timing of every case in rounds, and the ratios
-// to the timing `reference` ("" for none) and to embree. No rows when no ray
-// set applies.
+// screened, the referee's verdicts (accuracy runs), every backend that can
+// model the scene built (the others skipped with a note), agreement with
+// Embree, the timing of every case in rounds, and the ratios to the timing
+// `reference` ("" for none) and to embree. No rows when no ray set applies.
 SceneResults measure_scene(const RunOptions& options, const std::string& reference, const LoadedScene& loaded,
                            std::size_t index, std::size_t count) {
   const Scene& scene = loaded.scene;
@@ -147,6 +148,12 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
     return results;
   }
 
+  // Backends lacking a primitive type of the scene are skipped for it, with
+  // a note: never given a scene they would trace wrongly (a plugin would see
+  // only its triangles).
+  const std::vector<std::string> runnable = backends_for_scene(settings.backends, scene, results.skipped);
+  for (const SkippedBackend& s : results.skipped) progress(fmt::format("  {}: skipped, {}", s.backend, s.reason));
+
   struct Case {
     std::string name;
     ResultRow row;
@@ -163,6 +170,8 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
     const TraceExecutor& executor = *executors.back();
     // Embree's answers, per ray set, for agreement.
     std::unique_ptr<Backend> baseline = make_backend(kAgreementBackend, {threads});
+    if (const std::string problem = capability_problem(*baseline, scene); !problem.empty())
+      throw std::logic_error("the agreement baseline must model every scene: " + problem);
     executor.run([&] { baseline->build(scene); });
     std::vector<std::vector<Hit>> ref_hits(raysets.size());
     std::vector<std::vector<std::uint8_t>> ref_occ(raysets.size());
@@ -183,14 +192,14 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
     }
 
     std::vector<Backend*> built;
-    for (const std::string& backend_name : settings.backends) {
+    for (const std::string& backend_name : runnable) {
       backends.push_back(make_backend(backend_name, {threads}));
       built.push_back(backends.back().get());
     }
     const std::vector<std::vector<double>> build_times =
         time_builds_interleaved(built, scene, executor, settings.build_repetitions, settings.min_time);
     for (std::size_t bi = 0; bi < built.size(); ++bi) {
-      const std::string& backend_name = settings.backends[bi];
+      const std::string& backend_name = runnable[bi];
       const Backend* backend = built[bi];
       const std::vector<double>& build_ms = build_times[bi];
       progress(fmt::format("  built {} ({} threads) in {:.1f} ms, {:.1f} MiB", backend_name, threads, median(build_ms),
@@ -366,6 +375,21 @@ std::size_t write_finished_scenes(const RunOptions& options, const Metadata& run
 
 }  // namespace
 
+std::vector<std::string> backends_for_scene(const std::vector<std::string>& names, const Scene& scene,
+                                            std::vector<SkippedBackend>& skipped) {
+  std::vector<std::string> runnable;
+  for (const std::string& name : names) {
+    if (const std::string problem = capability_problem(*make_backend(name), scene); !problem.empty()) {
+      const bool noted = std::any_of(skipped.begin(), skipped.end(),
+                                     [&](const SkippedBackend& s) { return s.scene == scene.name && s.backend == name; });
+      if (!noted) skipped.push_back({scene.name, name, problem});
+    } else {
+      runnable.push_back(name);
+    }
+  }
+  return runnable;
+}
+
 std::string timing_reference(const SuiteSettings& settings) {
   const auto in_run = [&](const std::string& name) {
     return std::find(settings.backends.begin(), settings.backends.end(), name) != settings.backends.end();
@@ -453,6 +477,10 @@ RunResults run_suite(const RunOptions& options) {
       rows.insert(rows.end(), scene.rows.begin(), scene.rows.end());
       accuracy_rows.insert(accuracy_rows.end(), scene.accuracy.begin(), scene.accuracy.end());
       if (scene.camera) results.cameras.push_back(*scene.camera);
+      for (const SkippedBackend& s : scene.skipped) {
+        run_description.emplace_back(fmt::format("skipped.{}.{}", toml_key(s.scene), toml_key(s.backend)), s.reason);
+        results.skipped.push_back(s);
+      }
       finished = write_finished_scenes(options, run_description, rows, accuracy_rows, si + 1, scenes.size());
     }
   } catch (const std::exception& e) {
