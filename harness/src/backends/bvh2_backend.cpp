@@ -10,15 +10,12 @@
 // "bvh2:watertight:lbvh") picks the builder; binned SAH by default.
 // "reinsert" optimises the built tree by reinsertion (bvh2_reinsertion.h).
 // Options come in any order, each kind at most once.
-// A scene with analytic primitives (Scene::has_analytic) is built, by
-// build(), into one tree over all of them (raybench/bvh/mixed_bvh2.h): the
-// triangles judged by the backend's triangle test, spheres, boxes and
-// oriented boxes by SpherePrecise, Slab and Obb, or by the seed notes' tests
-// with "sphere_seed", "box_seed", "obb_seed". Only the binned builder takes
-// primitive boxes: another builder refuses such a scene. A triangle-only
-// scene runs exactly the code it ran before: the same tree, the same
-// template instantiations; the mixed path is a separate member, reached by
-// one test per batch.
+// Scenes with analytic primitives (issue 31): the family is registered
+// through backends/mixed_bvh_backends.h, which pairs each backend made here
+// with one tree over all primitives (raybench/bvh/mixed_bvh2.h) for such
+// scenes; "sphere_seed", "box_seed", "obb_seed" choose the seed notes' tests
+// for them. Nothing else in this file changed: a triangle-only scene is
+// traced by Bvh2Backend, compiled as before.
 #include <algorithm>
 #include <optional>
 #include <tuple>
@@ -28,10 +25,10 @@
 
 #include "backends/backend.h"
 #include "backends/bvh_options.h"
+#include "backends/mixed_bvh_backends.h"
 #include "io/error.h"
 #include "raybench/bvh/bvh2_builders.h"
 #include "raybench/bvh/bvh2_traverse.h"
-#include "raybench/bvh/mixed_bvh2.h"
 #include "raybench/prim/aabb_slab_robust.h"
 #include "raybench/variants.h"
 
@@ -41,24 +38,13 @@ namespace {
 template <typename Test, typename BoxTest>
 class Bvh2Backend final : public Backend {
  public:
-  Bvh2Backend(std::string name, Bvh2Builder builder, const Bvh2BuildOptions& options, AnalyticTestChoice analytic)
-      : name_(std::move(name)), builder_(builder), options_(options), analytic_(analytic) {}
+  Bvh2Backend(std::string name, Bvh2Builder builder, const Bvh2BuildOptions& options)
+      : name_(std::move(name)), builder_(builder), options_(options) {}
 
   const std::string& name() const override { return name_; }
 
-  Capabilities capabilities() const override {
-    Capabilities c;
-    c.spheres = c.boxes = c.oriented_boxes = true;
-    return c;
-  }
-
   void build(const Scene& scene) override {
     bvh_ = {};  // the old tree freed first, as Embree releases its old scene first
-    mixed_.reset();
-    if (scene.has_analytic()) {
-      build_mixed(scene);
-      return;
-    }
     bvh_ = build_bvh2(scene.triangles, builder_, options_);
     prepared_.clear();
     prepared_.reserve(bvh_.prim_ids.size());
@@ -66,52 +52,28 @@ class Bvh2Backend final : public Backend {
   }
 
   std::size_t memory_bytes() const override {
-    if (mixed_) return mixed_->memory_bytes();
     return bvh_.memory_bytes() + prepared_.size() * sizeof(typename Test::Prepared);
   }
 
-  // Bvh2::sah_cost: inner nodes and single primitive tests cost 1 each.
-  double sah_cost() const override { return mixed_ ? mixed_->bvh.sah_cost() : bvh_.sah_cost(); }
+  // Bvh2::sah_cost: inner nodes and single triangle tests cost 1 each.
+  double sah_cost() const override { return bvh_.sah_cost(); }
 
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
-    if (mixed_) return intersect_mixed(rays, hits);
     for (std::size_t i = 0; i < rays.size(); ++i)
       hits[i] = is_traceable(rays[i]) ? intersect_bvh2<Test, BoxTest>(bvh_, prepared_, with_nonnegative_tnear(rays[i])) : Hit{};
   }
 
   void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override {
-    if (mixed_) return occluded_mixed(rays, occluded);
     for (std::size_t i = 0; i < rays.size(); ++i)
       occluded[i] = is_traceable(rays[i]) && occluded_bvh2<Test, BoxTest>(bvh_, prepared_, with_nonnegative_tnear(rays[i]));
   }
 
  private:
-  // The mixed path, apart from the triangle-only one (noinline: its
-  // traversal is not inlined into the triangle-only batch functions).
-  [[gnu::noinline]] void build_mixed(const Scene& scene) {
-    if (builder_ != Bvh2Builder::kBinnedSah)
-      throw InputError("", fmt::format("backend '{}' cannot build scene '{}': its analytic primitives are built over "
-                                       "their boxes by the binned builder only; drop ':{}'",
-                                       name_, scene.name, to_string(builder_)));
-    prepared_ = {};
-    mixed_ = std::make_unique<MixedBvh2<Test>>(build_mixed_bvh2<Test>(scene.primitives(), options_, analytic_));
-  }
-  [[gnu::noinline]] void intersect_mixed(std::span<const Ray> rays, std::span<Hit> hits) const {
-    for (std::size_t i = 0; i < rays.size(); ++i)
-      hits[i] = is_traceable(rays[i]) ? intersect_mixed_bvh2<Test, BoxTest>(*mixed_, with_nonnegative_tnear(rays[i])) : Hit{};
-  }
-  [[gnu::noinline]] void occluded_mixed(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const {
-    for (std::size_t i = 0; i < rays.size(); ++i)
-      occluded[i] = is_traceable(rays[i]) && occluded_mixed_bvh2<Test, BoxTest>(*mixed_, with_nonnegative_tnear(rays[i]));
-  }
-
   std::string name_;
   Bvh2Builder builder_;
   Bvh2BuildOptions options_;
-  AnalyticTestChoice analytic_;
   Bvh2 bvh_;
   std::vector<typename Test::Prepared> prepared_;
-  std::unique_ptr<MixedBvh2<Test>> mixed_;  // the tree of a scene with analytic primitives, else null
 };
 
 std::unique_ptr<Backend> make_bvh2_backend(const std::string& name, const std::vector<std::string>& options,
@@ -127,16 +89,15 @@ std::unique_ptr<Backend> make_bvh2_backend(const std::string& name, const std::v
     using Test = decltype(test);
     if (Test::name != wanted) return;
     const Bvh2Builder b = parsed.builder_or_default();
-    if (parsed.robust()) made = std::make_unique<Bvh2Backend<Test, SlabRobust>>(name, b, build_options, parsed.analytic);
-    else made = std::make_unique<Bvh2Backend<Test, Slab>>(name, b, build_options, parsed.analytic);
+    if (parsed.robust()) made = std::make_unique<Bvh2Backend<Test, SlabRobust>>(name, b, build_options);
+    else made = std::make_unique<Bvh2Backend<Test, Slab>>(name, b, build_options);
   });
   return made;
 }
 
 std::vector<BackendInfo> bvh2_backend_names() {
   const std::string default_accuracy(to_string(std::tuple_element_t<0, TriangleTests>::accuracy));
-  std::vector<BackendInfo> out{{"bvh2", "our binary BVH, binned SAH build, with the default triangle test; analytic "
-                                        "spheres, boxes and OBBs in the same tree (sphere_precise, slab, obb)"}};
+  std::vector<BackendInfo> out{{"bvh2", "our binary BVH, binned SAH build, with the default triangle test"}};
   for_each_variant<TriangleTests>([&](auto test) {
     using Test = decltype(test);
     const bool watertight = Test::name == kWatertightTest;  // traversed with the conservative box test
@@ -165,12 +126,11 @@ std::vector<BackendInfo> bvh2_backend_names() {
                              "any bvh2 name takes :{}",
                              kReinsertOption),
                  default_accuracy});
-  append_analytic_seed_names(out, "bvh2");
   return out;
 }
 
 }  // namespace
 
-RAYBENCH_BACKEND_FAMILY("bvh2", 200, make_bvh2_backend, bvh2_backend_names);
+RAYBENCH_BVH_FAMILY_WITH_ANALYTIC("bvh2", 200, make_bvh2_backend, bvh2_backend_names);
 
 }  // namespace raybench

@@ -19,15 +19,12 @@
 //   reinsert: the BVH2 optimised by reinsertion before the collapse
 //     (bvh2_reinsertion.h);
 //   sphere_seed, box_seed, obb_seed: the seed notes' tests for analytic
-//     primitives instead of SpherePrecise, Slab, Obb.
-// A scene with analytic primitives (Scene::has_analytic) is built, by
-// build(), into one wide tree over all of them (raybench/bvh/
-// mixed_wide_bvh.h): the triangles in each pack tested by the leaf test
-// above, the analytic primitives after them one by one. Only the binned
-// builder takes primitive boxes: another builder refuses such a scene. A
-// triangle-only scene runs exactly the code it ran before: the same tree,
-// the same template instantiations (the bvh8 plugin's too); the mixed path
-// is a separate member, reached by one test per batch.
+//     primitives instead of SpherePrecise, Slab, Obb (issue 31).
+// Scenes with analytic primitives: the families are registered through
+// backends/mixed_bvh_backends.h, which pairs each backend made here with one
+// wide tree over all primitives (raybench/bvh/mixed_wide_bvh.h) for such
+// scenes. Nothing else in this file changed: a triangle-only scene is
+// traced by WideBvhBackend, compiled as before.
 #include <algorithm>
 #include <span>
 
@@ -35,9 +32,9 @@
 
 #include "backends/backend.h"
 #include "backends/bvh_options.h"
+#include "backends/mixed_bvh_backends.h"
 #include "io/error.h"
 #include "raybench/bvh/bvh2_builders.h"
-#include "raybench/bvh/mixed_wide_bvh.h"
 #include "raybench/bvh/wide_bvh_batch.h"
 
 namespace raybench {
@@ -46,76 +43,43 @@ namespace {
 template <int W, typename Leaf, typename BoxTest>
 class WideBvhBackend final : public Backend {
  public:
-  WideBvhBackend(std::string name, Bvh2Builder builder, int reinsertion_passes, AnalyticTestChoice analytic)
-      : name_(std::move(name)), builder_(builder), reinsertion_passes_(reinsertion_passes), analytic_(analytic) {}
+  WideBvhBackend(std::string name, Bvh2Builder builder, int reinsertion_passes)
+      : name_(std::move(name)), builder_(builder), reinsertion_passes_(reinsertion_passes) {}
 
   const std::string& name() const override { return name_; }
 
-  Capabilities capabilities() const override {
-    Capabilities c;
-    c.spheres = c.boxes = c.oriented_boxes = true;
-    return c;
-  }
-
   void build(const Scene& scene) override {
     bvh_ = {};  // the old tree freed first, as Embree releases its old scene first
-    mixed_.reset();
-    if (scene.has_analytic()) {
-      build_mixed(scene);
-      return;
-    }
     bvh_ = build_wide_bvh<W, Leaf>(scene.triangles, builder_, reinsertion_passes_);
   }
 
-  std::size_t memory_bytes() const override { return mixed_ ? mixed_->memory_bytes() : bvh_.memory_bytes(); }
+  std::size_t memory_bytes() const override { return bvh_.memory_bytes(); }
 
   // WideBvh::sah_cost, of the wide tree traced: node visits and W-triangle
-  // pack tests cost 1 each (computed here, outside the timed build); a
-  // mixed pack counts 1 too.
-  double sah_cost() const override { return mixed_ ? mixed_->sah_cost() : bvh_.sah_cost(); }
+  // pack tests cost 1 each (computed here, outside the timed build).
+  double sah_cost() const override { return bvh_.sah_cost(); }
 
   // The same code as the in-tree plugin wrapping bvh8 (bvh/wide_bvh_batch.h).
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
-    if (mixed_) return intersect_mixed(rays, hits);
     intersect_wide_batch<Leaf, BoxTest>(bvh_, rays, hits);
   }
 
   void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override {
-    if (mixed_) return occluded_mixed(rays, occluded);
     occluded_wide_batch<Leaf, BoxTest>(bvh_, rays, occluded);
   }
 
  private:
-  // The mixed path, apart from the triangle-only one (noinline: its
-  // traversal is not inlined into the triangle-only batch functions).
-  [[gnu::noinline]] void build_mixed(const Scene& scene) {
-    if (builder_ != Bvh2Builder::kBinnedSah)
-      throw InputError("", fmt::format("backend '{}' cannot build scene '{}': its analytic primitives are built over "
-                                       "their boxes by the binned builder only; drop ':{}'",
-                                       name_, scene.name, to_string(builder_)));
-    mixed_ = std::make_unique<MixedWideBvh<W>>(
-        build_mixed_wide_bvh<W, Leaf>(scene.primitives(), reinsertion_passes_, analytic_));
-  }
-  [[gnu::noinline]] void intersect_mixed(std::span<const Ray> rays, std::span<Hit> hits) const {
-    intersect_wide_batch<MixedWideLeaf<Leaf>, BoxTest>(*mixed_, rays, hits);
-  }
-  [[gnu::noinline]] void occluded_mixed(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const {
-    occluded_wide_batch<MixedWideLeaf<Leaf>, BoxTest>(*mixed_, rays, occluded);
-  }
-
   std::string name_;
   Bvh2Builder builder_;
   int reinsertion_passes_;
-  AnalyticTestChoice analytic_;
   WideBvh<W> bvh_;
-  std::unique_ptr<MixedWideBvh<W>> mixed_;  // the tree of a scene with analytic primitives, else null
 };
 
 template <int W, typename Leaf>
 std::unique_ptr<Backend> make_with_box_test(const std::string& name, Bvh2Builder builder, int reinsertion_passes,
-                                            bool robust, AnalyticTestChoice analytic) {
-  if (robust) return std::make_unique<WideBvhBackend<W, Leaf, SlabRobustRay>>(name, builder, reinsertion_passes, analytic);
-  return std::make_unique<WideBvhBackend<W, Leaf, SlabFma>>(name, builder, reinsertion_passes, analytic);
+                                            bool robust) {
+  if (robust) return std::make_unique<WideBvhBackend<W, Leaf, SlabRobustRay>>(name, builder, reinsertion_passes);
+  return std::make_unique<WideBvhBackend<W, Leaf, SlabFma>>(name, builder, reinsertion_passes);
 }
 
 template <int W>
@@ -131,22 +95,18 @@ std::unique_ptr<Backend> make_wide_backend(const std::string& name, const std::v
   const Bvh2Builder b = parsed.builder_or_default();
   const int passes = parsed.reinsertion_passes();
   if constexpr (W == 8) {
-    if (parsed.test == kWatertightTest)
-      return make_with_box_test<8, Bvh8Watertight>(name, b, passes, parsed.robust(), parsed.analytic);
+    if (parsed.test == kWatertightTest) return make_with_box_test<8, Bvh8Watertight>(name, b, passes, parsed.robust());
   }
-  if (parsed.test.value_or("mt") == "mt_edges")
-    return make_with_box_test<W, WideMollerTrumboreEdges>(name, b, passes, parsed.robust(), parsed.analytic);
-  return make_with_box_test<W, WideMollerTrumbore>(name, b, passes, parsed.robust(), parsed.analytic);
+  if (parsed.test.value_or("mt") == "mt_edges") return make_with_box_test<W, WideMollerTrumboreEdges>(name, b, passes, parsed.robust());
+  return make_with_box_test<W, WideMollerTrumbore>(name, b, passes, parsed.robust());
 }
 
 template <int W>
 std::vector<BackendInfo> wide_backend_names() {
   const std::string family = fmt::format("bvh{}", W);
   std::vector<BackendInfo> out{
-      {family, fmt::format("{}-wide BVH collapsed from bvh2, {} node and leaf tests, Moller-Trumbore leaves of {}; "
-                           "analytic spheres, boxes and OBBs in the same leaves, tested one by one (sphere_precise, "
-                           "slab, obb)",
-                           W, kHaveAvx2 ? (W == 8 ? "AVX2" : "SSE") : "scalar fallback", W)}};
+      {family, fmt::format("{}-wide BVH collapsed from bvh2, {} node and leaf tests, Moller-Trumbore leaves of {}", W,
+                           kHaveAvx2 ? (W == 8 ? "AVX2" : "SSE") : "scalar fallback", W)}};
   for (Bvh2Builder b : kBvh2Builders) {
     if (b == Bvh2Builder::kBinnedSah) continue;  // the default: plain "bvh8"
     out.push_back({family + ":" + std::string(to_string(b)),
@@ -177,7 +137,6 @@ std::vector<BackendInfo> wide_backend_names() {
   out.push_back({family + ":robust", fmt::format("{} with the conservative {}-wide box test (slab_robust_ray); any {} "
                                                  "name takes :robust or :plain_boxes (slab_fma, the default) for its box test",
                                                  family, W, family)});
-  append_analytic_seed_names(out, family);
   return out;
 }
 
@@ -195,7 +154,7 @@ std::vector<BackendInfo> bvh4_backend_names() { return wide_backend_names<4>(); 
 
 }  // namespace
 
-RAYBENCH_BACKEND_FAMILY("bvh8", 300, make_bvh8_backend, bvh8_backend_names);
-RAYBENCH_BACKEND_FAMILY("bvh4", 400, make_bvh4_backend, bvh4_backend_names);
+RAYBENCH_BVH_FAMILY_WITH_ANALYTIC("bvh8", 300, make_bvh8_backend, bvh8_backend_names);
+RAYBENCH_BVH_FAMILY_WITH_ANALYTIC("bvh4", 400, make_bvh4_backend, bvh4_backend_names);
 
 }  // namespace raybench
