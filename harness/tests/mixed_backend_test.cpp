@@ -207,6 +207,8 @@ TEST(MixedBackends, ASceneOfAnalyticPrimitivesOnlyIsTraced) {
     SCOPED_TRACE(name);
     const auto backend = make_backend(name);
     backend->build(scene);
+    EXPECT_GT(backend->memory_bytes(), scene.primitive_count() * sizeof(Sphere));
+    EXPECT_GT(backend->sah_cost(), 1.0);  // the root's own visit costs 1
     std::vector<Hit> hits(rays.size());
     backend->intersect(rays, hits);
     std::size_t same = 0;
