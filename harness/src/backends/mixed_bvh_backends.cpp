@@ -172,14 +172,18 @@ std::vector<std::string_view> triangle_tests(OurBvhFamily family) {
   return {"mt", "mt_edges"};
 }
 
-// The mixed backend of the options the family's factory has just accepted:
-// the same triangle test, box test, builder and reinsertion, and the
-// analytic tests they choose.
+// The options the family's factory has just accepted.
+BvhOptions parse(OurBvhFamily family, const std::string& name, const std::vector<std::string>& options) {
+  const std::string_view family_name = families()[static_cast<std::size_t>(family)].name;
+  return parse_bvh_options(name, family_name, options, triangle_tests(family), family_name);
+}
+
+// The mixed backend of those options: the same triangle test, box test,
+// builder and reinsertion, and the analytic tests they choose.
 std::unique_ptr<Backend> make_mixed(OurBvhFamily family, const std::string& name,
                                     const std::vector<std::string>& options) {
   const std::vector<std::string_view> tests = triangle_tests(family);
-  const std::string_view family_name = families()[static_cast<std::size_t>(family)].name;
-  const BvhOptions parsed = parse_bvh_options(name, family_name, options, tests, family_name);
+  const BvhOptions parsed = parse(family, name, options);
   const Bvh2Builder builder = parsed.builder_or_default();
   if (family == OurBvhFamily::kBvh2) {
     Bvh2BuildOptions build_options;
@@ -199,7 +203,11 @@ template <OurBvhFamily F>
 std::unique_ptr<Backend> make_with_analytic(const std::string& name, const std::vector<std::string>& options,
                                             const BackendConfig& config) {
   std::unique_ptr<Backend> triangles = families()[static_cast<std::size_t>(F)].make(name, options, config);
-  return std::make_unique<AnalyticDispatchBackend>(std::move(triangles), every_type(),
+  // Only the binned builder takes primitive boxes: with another the pair
+  // models triangles only, and the run skips it on scenes with analytic
+  // primitives (its build() of one refuses it).
+  const bool binned = parse(F, name, options).builder_or_default() == Bvh2Builder::kBinnedSah;
+  return std::make_unique<AnalyticDispatchBackend>(std::move(triangles), binned ? every_type() : Capabilities{},
                                                    [name, options] { return make_mixed(F, name, options); });
 }
 

@@ -5,16 +5,17 @@
 // (analytic_dispatch.h), with a backend tracing one tree over triangles,
 // spheres, boxes and oriented boxes (raybench/bvh/mixed_bvh2.h,
 // mixed_wide_bvh.h) with the same triangle test and box test; the families'
-// names gain the seed options of analytic_test_choice.h. Capabilities: every
-// type.
+// names gain the seed options of analytic_test_choice.h.
 // Why from here and not in the families' files: a scene without analytic
 // primitives must run exactly the code it ran before. Any change to those
 // translation units (a branch in the backend, the mixed instantiations
 // beside it, even a longer factory) changed how GCC inlined and allocated
 // registers in some of their traversal loops; with only their registration
 // line changed, their code is the same, instruction for instruction.
-// The mixed backends accept only the binned builder (primitive boxes): with
-// another one, build() on a scene with analytic primitives throws an
+// The mixed backends accept only the binned builder (primitive boxes). So
+// capabilities() is every type with the binned builder and triangles only
+// with another (the run skips such a backend on scenes with analytic
+// primitives), and build() of such a scene with another builder throws an
 // InputError naming the backend and the scene.
 #pragma once
 
