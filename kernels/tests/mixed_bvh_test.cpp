@@ -484,17 +484,31 @@ TEST(MixedBvh2, RaysWithNaNOrInfMissEverything) {
 template <int W, typename TriLeaf>
 void expect_pack_layout(const MixedScene& s, const MixedWideBvh<W>& m) {
   const PrimitiveSpans p = s.spans();
-  ASSERT_EQ(m.mixed_packs.size() * W, m.pack_prims.size());
+  const std::size_t pack_count = m.pack_prims.size() / W;
+  ASSERT_EQ(m.first_mixed_pack + m.mixed_packs.size(), pack_count);
+  if (!s.triangles.empty()) {
+    EXPECT_GT(m.first_mixed_pack, 0u);  // packs of triangles only exist, and come first
+  }
+  EXPECT_GT(m.mixed_packs.size(), 0u);
   std::vector<int> seen(p.size(), 0);
-  std::vector<BBox> pack_box(m.mixed_packs.size());
+  std::vector<BBox> pack_box(pack_count);
   for (const WideNode<W>& n : m.nodes)
     for (int lane = 0; lane < W; ++lane)
       if (n.child[lane] != WideBvh<W>::kEmptyChild && (n.child[lane] & WideBvh<W>::kLeafBit))
         pack_box[n.child[lane] & ~WideBvh<W>::kLeafBit] = n.bounds.lane(lane);
   std::size_t analytic = 0;
-  for (std::size_t pack = 0; pack < m.mixed_packs.size(); ++pack) {
-    const MixedPack& info = m.mixed_packs[pack];
-    EXPECT_EQ(info.first, analytic);
+  for (std::size_t pack = 0; pack < pack_count; ++pack) {
+    // The packs of triangles only first (no MixedPack), then the others.
+    MixedPack info;
+    if (pack < m.first_mixed_pack) {
+      int used = 0;
+      while (used < W && m.pack_prims[WideBvh<W>::slot(static_cast<std::uint32_t>(pack), used)] >= 0) ++used;
+      info.lane = static_cast<std::uint8_t>(used);
+    } else {
+      info = m.mixed_packs[pack - m.first_mixed_pack];
+      EXPECT_GT(info.count, 0);
+      EXPECT_EQ(info.first, analytic);
+    }
     for (int lane = 0; lane < W; ++lane) {
       const std::int32_t id = m.pack_prims[WideBvh<W>::slot(static_cast<std::uint32_t>(pack), lane)];
       if (lane >= info.lane + info.count) {

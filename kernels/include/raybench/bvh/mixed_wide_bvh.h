@@ -12,15 +12,17 @@
 // the lanes after them, tested one by one (scalar) by their surface tests
 // (mixed_leaf.h: SpherePrecise, Slab, Obb, or the seed-faithful ones).
 // pack_prims holds every lane's global prim id, so hits map to ids as in
-// the triangle-only tree.
-// Cost against the triangle-only tree: 8 bytes per pack (MixedPack) and 4
-// per analytic primitive beside its copy; per pack visited, one load of its
-// MixedPack and a branch; a pack with no triangle skips the SIMD test, a
-// pack with analytic primitives tests them scalar, one after the other
-// (any-hit included: the leaf test does not know the query, and a triangle
-// hit ends an occlusion ray only after the pack's analytic tests). The
-// collapse's SAH counts a pack as one test whatever it holds, which
-// underestimates packs of several analytic primitives.
+// the triangle-only tree. The packs without analytic primitives come first
+// (in the collapse's order), the others after them, so a leaf tells which
+// it is by comparing its pack index with first_mixed_pack, without a load.
+// Cost against the triangle-only tree: per pack visited one comparison; per
+// pack with analytic primitives 8 bytes (MixedPack), one load of it, and
+// their tests, scalar, one after the other (any-hit included: the leaf test
+// does not know the query, and a triangle hit ends an occlusion ray only
+// after the pack's analytic tests); a pack with no triangle skips the SIMD
+// test. 4 bytes per analytic primitive beside its copy. The collapse's SAH
+// counts a pack as one test whatever it holds, which underestimates packs of
+// several analytic primitives; packs moved to the end lose some locality.
 // The collapse needs a triangle per primitive to pack: an analytic one is
 // given a stand-in, a triangle across its box (whose area feeds the
 // occlusion lane order's hit chance), which the repacking then drops, so no
@@ -30,6 +32,8 @@
 // global prim ids (PrimitiveSpans), analytic hits u = v = 0.
 #pragma once
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <stdexcept>
@@ -43,9 +47,9 @@
 
 namespace raybench {
 
-// The analytic lanes of one pack: lanes [lane, lane + count), their
-// references at MixedWideBvh::analytic_refs[first ...]. Lanes below `lane`
-// are the pack's triangles.
+// The analytic lanes of one pack: lanes [lane, lane + count), count > 0,
+// their references at MixedWideBvh::analytic_refs[first ...]. Lanes below
+// `lane` are the pack's triangles.
 struct MixedPack {
   std::uint32_t first = 0;
   std::uint8_t lane = 0;
@@ -56,7 +60,8 @@ struct MixedPack {
 // what this adds through the WideBvh<W> the traversal hands it.
 template <int W>
 struct MixedWideBvh : WideBvh<W> {
-  std::vector<MixedPack> mixed_packs;        // one per pack
+  std::uint32_t first_mixed_pack = 0;        // packs below hold triangles only
+  std::vector<MixedPack> mixed_packs;        // pack first_mixed_pack + i: mixed_packs[i]
   std::vector<std::uint32_t> analytic_refs;  // mixed_ref of each analytic lane, pack by pack
   AnalyticLeafPrims analytic;                // the analytic primitives in pack order, and their tests
 
@@ -88,7 +93,8 @@ struct MixedWideLeaf {
   RAYBENCH_INLINE static int intersect(const RayData& ray, float tmax, const WideBvh<W>& bvh, std::uint32_t pack,
                                        TriangleHit& out) {
     const auto& m = static_cast<const MixedWideBvh<W>&>(bvh);
-    const MixedPack p = m.mixed_packs[pack];
+    if (pack < m.first_mixed_pack) return TriangleLeaf::intersect(ray.triangle, tmax, bvh, pack, out);
+    const MixedPack p = m.mixed_packs[pack - m.first_mixed_pack];
     int lane = -1;
     if (p.lane != 0) {
       lane = TriangleLeaf::intersect(ray.triangle, tmax, bvh, pack, out);
@@ -148,7 +154,7 @@ MixedWideBvh<W> build_mixed_wide_bvh(const PrimitiveSpans& prims, int reinsertio
   // its analytic primitives to the lanes after them.
   m.analytic.tests = tests;
   const std::size_t pack_count = m.pack_prims.size() / W;
-  m.mixed_packs.resize(pack_count);
+  std::vector<MixedPack> infos(pack_count);
   for (std::size_t p = 0; p < pack_count; ++p) {
     std::int32_t ids[W];
     Triangle tris[W];
@@ -161,7 +167,7 @@ MixedWideBvh<W> build_mixed_wide_bvh(const PrimitiveSpans& prims, int reinsertio
       }
     }
     count = triangles;
-    MixedPack& info = m.mixed_packs[p];
+    MixedPack& info = infos[p];
     info.first = static_cast<std::uint32_t>(m.analytic_refs.size());
     info.lane = static_cast<std::uint8_t>(triangles);
     for (int lane = 0; lane < W; ++lane) {
@@ -182,6 +188,34 @@ MixedWideBvh<W> build_mixed_wide_bvh(const PrimitiveSpans& prims, int reinsertio
         break;
     }
   }
+
+  // The packs without analytic primitives first, then the others, each in
+  // the collapse's order; the nodes' references follow.
+  std::vector<std::uint32_t> new_index(pack_count);
+  std::uint32_t next = 0;
+  for (std::size_t p = 0; p < pack_count; ++p)
+    if (infos[p].count == 0) new_index[p] = next++;
+  m.first_mixed_pack = next;
+  for (std::size_t p = 0; p < pack_count; ++p)
+    if (infos[p].count != 0) {
+      new_index[p] = next++;
+      m.mixed_packs.push_back(infos[p]);
+    }
+  const auto permute = [&](auto& v, std::size_t per_pack) {
+    if (v.empty()) return;
+    const auto old = v;
+    for (std::size_t p = 0; p < pack_count; ++p)
+      std::copy_n(old.begin() + static_cast<std::ptrdiff_t>(p * per_pack), per_pack,
+                  v.begin() + static_cast<std::ptrdiff_t>(new_index[p] * per_pack));
+  };
+  permute(m.packs, 1);
+  permute(m.edge_packs, 1);
+  permute(m.vertex_packs, 1);
+  permute(m.pack_prims, W);
+  for (WideNode<W>& node : m.nodes)
+    for (std::uint32_t& child : node.child)
+      if (child != WideBvh<W>::kEmptyChild && (child & WideBvh<W>::kLeafBit))
+        child = WideBvh<W>::kLeafBit | new_index[child & ~WideBvh<W>::kLeafBit];
   return m;
 }
 
