@@ -150,12 +150,21 @@ MixedWideBvh<W> build_mixed_wide_bvh(const PrimitiveSpans& prims, int reinsertio
   static_cast<WideBvh<W>&>(m) = collapse_bvh2<W>(bvh2, stand_ins, TriangleLeaf::kLeaves,
                                                  quality ? WideLaneOrder::kOcclusion : WideLaneOrder::kByArea);
 
-  // Each pack's triangles to its first lanes, repacked without the stand-ins;
-  // its analytic primitives to the lanes after them.
+  // Each pack with analytic primitives: its triangles to its first lanes,
+  // repacked without the stand-ins, its analytic primitives to the lanes
+  // after them. A pack of triangles only is already what the triangle-only
+  // tree holds.
   m.analytic.tests = tests;
   const std::size_t pack_count = m.pack_prims.size() / W;
+  const auto analytic_lane = [&](std::size_t p, int lane) {
+    const std::int32_t id = m.pack_prims[WideBvh<W>::slot(static_cast<std::uint32_t>(p), lane)];
+    return id >= 0 && static_cast<std::size_t>(id) >= prims.first_sphere();
+  };
   std::vector<MixedPack> infos(pack_count);
   for (std::size_t p = 0; p < pack_count; ++p) {
+    bool mixed = false;
+    for (int lane = 0; lane < W; ++lane) mixed = mixed || analytic_lane(p, lane);
+    if (!mixed) continue;
     std::int32_t ids[W];
     Triangle tris[W];
     int triangles = 0, count = 0;
