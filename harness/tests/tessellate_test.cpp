@@ -6,11 +6,18 @@
 
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <map>
+#include <set>
 #include <tuple>
 
+#include "accuracy/accuracy_csv.h"
 #include "backends/backend.h"
 #include "measure/trace.h"
+#include "results/metadata.h"
+#include "results/results_csv.h"
+#include "suite/suite_run.h"
 #include "test_util.h"
 
 namespace raybench {
@@ -277,6 +284,129 @@ TEST(Tessellate, AStandInApproachesItsSphereAsTheResolutionGrows) {
   EXPECT_LT(mean_error[1], mean_error[0] / 5);
   EXPECT_LT(mean_error[2], mean_error[1] / 5);
   EXPECT_GT(mean_error[2], 0.0);
+}
+
+
+// The tessellation study in a run (suite/suite_run.h): after a scene with
+// analytic primitives, each stand-in traced by every backend with the same
+// rays, its rows marked with their representation, and, in accuracy runs,
+// judged by the same referee. Scenes made here: a manifest cannot name
+// analytic primitives before the scene files land (issue 31).
+RunOptions small_run(const testing::TempDir& dir) {
+  RunOptions options;
+  options.settings.rays = 1024;
+  options.settings.raysets = {"primary", "shadow"};
+  options.settings.backends = {"embree", "bvh2"};
+  options.settings.repetitions = 1;
+  options.settings.build_repetitions = 1;
+  options.settings.min_time = 0.001;
+  options.settings.warmup = 0.0;
+  options.settings.tessellate = {{8, 4}, {32, 16}};
+  options.out_csv = dir.file("run.csv");
+  options.rays_dir = dir.file("rays");
+  return options;
+}
+
+Scene triangles_only() {
+  Scene s = mixed_scene();
+  s.name = "floor";
+  s.spheres.clear();
+  s.boxes.clear();
+  s.obbs.clear();
+  return s;
+}
+
+TEST(TessellationStudy, EachStandInIsTracedByEveryBackendWithTheScenesRaysAndJudgedByItsReferee) {
+  testing::TempDir dir;
+  RunOptions options = small_run(dir);
+  options.accuracy_csv = dir.file("accuracy.csv");
+  const RunResults results = run_scenes(options, {mixed_scene(), triangles_only()});
+  // (scene, representation, triangles) of every row, per ray set and backend.
+  std::map<std::string, std::pair<std::string, std::size_t>> seen;
+  std::map<std::string, int> rows_of;
+  for (const ResultRow& r : results.rows) {
+    seen[r.scene] = {r.representation, r.triangles};
+    ++rows_of[r.scene];
+    EXPECT_EQ(r.rays, 1024u);
+  }
+  const Scene mix = mixed_scene();
+  EXPECT_EQ(seen["mix"].first, "analytic");
+  EXPECT_EQ(seen["mix@uv8x4"], std::make_pair(std::string("uv8x4"), stand_in_triangle_count(mix, {8, 4})));
+  EXPECT_EQ(seen["mix@uv32x16"], std::make_pair(std::string("uv32x16"), stand_in_triangle_count(mix, {32, 16})));
+  EXPECT_EQ(seen["floor"].first, "triangles");
+  EXPECT_EQ(seen.size(), 4u) << "a scene without analytic primitives has no stand-in";
+  for (const auto& [scene, n] : rows_of) EXPECT_EQ(n, 2 * 2) << scene << ": every ray set and backend";
+  // The scene's rows, then its stand-ins', in the order given.
+  ASSERT_EQ(results.rows.size(), 16u);
+  EXPECT_EQ(results.rows[0].scene, "mix");
+  EXPECT_EQ(results.rows[4].scene, "mix@uv8x4");
+  EXPECT_EQ(results.rows[8].scene, "mix@uv32x16");
+  // On disk, with the run's resolutions in the metadata.
+  const auto csv = read_results_csv(options.out_csv);
+  ASSERT_EQ(csv.size(), 16u);
+  EXPECT_EQ(csv[5].at("representation"), "uv8x4");
+  EXPECT_EQ(csv[5].at("scene"), "mix@uv8x4");
+  std::ifstream meta(metadata_path_for(options.out_csv));
+  const std::string metadata((std::istreambuf_iterator<char>(meta)), std::istreambuf_iterator<char>());
+  EXPECT_NE(metadata.find("tessellate = \"8x4,32x16\""), std::string::npos) << metadata;
+
+  // The same rays and the same referee: what the truth says is the same for
+  // every representation; what each answered is its own.
+  const std::vector<AccuracyRow> accuracy = read_accuracy_csv(options.accuracy_csv);
+  ASSERT_EQ(accuracy.size(), 16u);
+  const auto row = [&](const std::string& scene, const std::string& rayset, const std::string& backend) {
+    for (const AccuracyRow& r : accuracy)
+      if (r.scene == scene && r.rayset == rayset && r.backend == backend) return r;
+    ADD_FAILURE() << "no accuracy row " << scene << " " << rayset << " " << backend;
+    return AccuracyRow{};
+  };
+  for (const char* rayset : {"primary", "shadow"}) {
+    const AccuracyRow analytic = row("mix", rayset, "bvh2");
+    EXPECT_EQ(analytic.representation, "analytic");
+    if (std::string(rayset) == "primary") EXPECT_GT(analytic.truth_hits, 0.0);
+    for (const char* stand_in : {"mix@uv8x4", "mix@uv32x16"}) {
+      for (const char* backend : {"embree", "bvh2"}) {
+        const AccuracyRow r = row(stand_in, rayset, backend);
+        EXPECT_EQ(r.representation, std::string(stand_in).substr(4));
+        EXPECT_EQ(r.rays, analytic.rays);
+        EXPECT_EQ(r.truth_hits, analytic.truth_hits) << stand_in << " " << rayset;
+        EXPECT_EQ(r.ambiguous, analytic.ambiguous) << stand_in << " " << rayset;
+        EXPECT_EQ(r.invalid, analytic.invalid);
+        EXPECT_GT(r.mrays_s, 0.0);
+      }
+    }
+  }
+  EXPECT_EQ(row("floor", "primary", "bvh2").representation, "triangles");
+}
+
+TEST(TessellationStudy, ASceneWithoutSpheresHasOneStandInAndNoneWhenTheListIsEmpty) {
+  testing::TempDir dir;
+  RunOptions options = small_run(dir);
+  options.settings.raysets = {"primary"};
+  Scene boxes = mixed_scene();
+  boxes.name = "boxes";
+  boxes.spheres.clear();
+  std::set<std::string> scenes;
+  for (const ResultRow& r : run_scenes(options, {boxes}).rows) scenes.insert(r.scene + " " + r.representation);
+  EXPECT_EQ(scenes, (std::set<std::string>{"boxes analytic", "boxes@uv8x4 uv8x4"}))
+      << "boxes are 12 triangles at every resolution: one stand-in, at the first";
+  options.settings.tessellate.clear();
+  scenes.clear();
+  for (const ResultRow& r : run_scenes(options, {mixed_scene()}).rows) scenes.insert(r.scene);
+  EXPECT_EQ(scenes, (std::set<std::string>{"mix"}));
+}
+
+TEST(TessellationStudy, AStandInBeyondInt32PrimIdsFailsBeforeAnySceneIsMeasured) {
+  testing::TempDir dir;
+  RunOptions options = small_run(dir);
+  options.settings.tessellate = {{16, 8}, {kMaxTessellation, kMaxTessellation}};
+  Scene many;
+  many.name = "many";
+  many.spheres.assign(65, Sphere{{0, 0, 0}, 1.0f});
+  Scene first = mixed_scene();  // measured first were the check late
+  const std::string message = testing::input_error_of([&] { run_scenes(options, {first, many}); });
+  EXPECT_NE(message.find("scene 'many': its uv4096x4096 stand-in would have"), std::string::npos) << message;
+  EXPECT_FALSE(testing::exists(options.out_csv)) << "nothing measured, nothing written";
 }
 
 }  // namespace

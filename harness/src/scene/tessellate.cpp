@@ -71,7 +71,9 @@ std::size_t sphere_triangles(const Tessellation& t) {
 
 }  // namespace
 
-std::string Tessellation::name() const { return fmt::format("uv{}x{}", segments, rings); }
+std::string Tessellation::name() const { return "uv" + spec(); }
+
+std::string Tessellation::spec() const { return fmt::format("{}x{}", segments, rings); }
 
 Tessellation parse_tessellation(std::string_view text, const std::string& where) {
   const std::string rule = fmt::format(

@@ -39,6 +39,8 @@ struct Tessellation {
 
   // "uv16x8": the representation, and the suffix of a stand-in's scene name.
   std::string name() const;
+  // "16x8", as parse_tessellation reads it.
+  std::string spec() const;
   bool operator==(const Tessellation&) const = default;
 };
 
