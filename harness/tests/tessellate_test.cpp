@@ -14,6 +14,7 @@
 
 #include "accuracy/accuracy_csv.h"
 #include "backends/backend.h"
+#include "io/error.h"
 #include "measure/trace.h"
 #include "results/metadata.h"
 #include "results/results_csv.h"
@@ -178,6 +179,28 @@ TEST(Tessellate, AnOrientedBoxBecomesTwelveTrianglesThroughItsCorners) {
     }
     EXPECT_GT(dot(cross(t.v1 - t.v0, t.v2 - t.v0), t.v0 - o.center), 0.0f) << "outward, triangle " << i;
   }
+}
+
+// proc:terrain_spheres tessellates its balls as UV spheres (64 segments by
+// 32 rings; the small one 32 by 16); terrain_spheres_analytic holds the same
+// terrain and the same balls as spheres: its stand-in at that resolution is
+// terrain_spheres, triangle for triangle, so the study's uv64x32 row is the
+// tessellated scene's.
+TEST(Tessellate, TheAnalyticTerrainsStandInIsTheTessellatedTerrain) {
+  Scene analytic;
+  try {
+    analytic = load_scene("proc:terrain_spheres_analytic_small");
+  } catch (const InputError& e) {
+    GTEST_SKIP() << "needs the procedural analytic scenes: " << e.what();
+  }
+  const Scene tessellated = load_scene("proc:terrain_spheres_small");
+  ASSERT_FALSE(analytic.spheres.empty());
+  // terrain_spheres_small: 16 rings by 32 segments.
+  const StandIn s = tessellate(analytic, {32, 16});
+  ASSERT_EQ(s.scene.triangles.size(), tessellated.triangles.size());
+  EXPECT_EQ(std::memcmp(s.scene.triangles.data(), tessellated.triangles.data(),
+                        tessellated.triangles.size() * sizeof(Triangle)),
+            0);
 }
 
 TEST(Tessellate, AStandInBeyondInt32PrimIdsIsRefusedBeforeAnyTriangleIsMade) {
