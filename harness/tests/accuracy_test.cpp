@@ -96,6 +96,67 @@ TEST(Judge, ASecondaryRayHittingItsOwnTriangleIsASelfIntersection) {
   EXPECT_DOUBLE_EQ(row.wrong_prim, 0.5);
 }
 
+// pair_and_floor with a sphere (prim 3) and a box (prim 4) above the floor.
+Scene pair_floor_sphere_box() {
+  Scene s = pair_and_floor();
+  s.spheres = {{{-2, -2, 0}, 0.5f}};
+  s.boxes = {{{2, -3, -0.5f}, {3, -2, 0.5f}}};
+  return s;
+}
+
+TEST(Judge, AnalyticHitsAreJudgedAsTrianglesAre) {
+  const Scene scene = pair_floor_sphere_box();
+  const Referee referee(scene);
+  const std::vector<Ray> rays = {
+      down_from(-2, -2),     // truth: the sphere's top at t = 0.5; answered right
+      down_from(-2, -2),     // the same, answered 3 float ulps late
+      down_from(2.5f, -2.5f),  // truth: the box's top at t = 0.5; answered as a miss (false miss)
+      down_from(2.5f, -2.5f),  // answered the floor behind it (wrong primitive)
+      down_from(4, 4),       // truth: a miss; answered the sphere (false hit)
+      down_from(0.75f, 0.6f),  // truth: triangle 1; answered the box (wrong primitive)
+  };
+  std::vector<RefereeVerdict> truth(rays.size());
+  referee.judge(rays, truth);
+  ASSERT_EQ(truth[0].prim, 3);
+  ASSERT_EQ(truth[2].prim, 4);
+  ASSERT_FALSE(truth[4].hit());
+  const float late = std::nextafter(std::nextafter(std::nextafter(0.5f, 1.0f), 1.0f), 1.0f);
+  const std::vector<Hit> hits = {{0.5f, 3, 0, 0}, {late, 3, 0, 0}, {}, {2.0f, 2, 0, 0}, {1.0f, 3, 0, 0}, {1.0f, 4, 0, 0}};
+  AccuracyRow row;
+  judge_hits(referee, rays, truth, hits, {}, row);
+  EXPECT_DOUBLE_EQ(row.truth_hits, 5.0 / 6);
+  EXPECT_DOUBLE_EQ(row.false_miss, 1.0 / 6);
+  EXPECT_DOUBLE_EQ(row.false_hit, 1.0 / 6);
+  EXPECT_DOUBLE_EQ(row.wrong_prim, 2.0 / 6);
+  EXPECT_DOUBLE_EQ(row.ambiguous, 0.0);
+  EXPECT_DOUBLE_EQ(row.ulp_p50, 0.0);
+  EXPECT_DOUBLE_EQ(row.ulp_max, 3.0);  // in float ulps at t = 0.5
+}
+
+TEST(Judge, ASecondaryRayHittingItsOwnSphereAgainIsASelfIntersection) {
+  const Scene scene = pair_floor_sphere_box();
+  const Referee referee(scene);
+  // Leaving the sphere's bottom downwards (just below it): the truth is the
+  // floor at z = -1. Answering the sphere itself is a self-intersection.
+  Ray down = down_from(-2, -2);
+  down.org.z = std::nextafter(-0.5f, -1.0f);
+  // Leaving its side outwards and back through it: the sphere is the truth, no self-hit.
+  Ray back;
+  back.org = {-2.75f, -2, 0};
+  back.dir = {1, 0, 0};
+  const std::vector<Ray> rays = {down, down, back};
+  std::vector<RefereeVerdict> truth(rays.size());
+  referee.judge(rays, truth);
+  ASSERT_EQ(truth[0].prim, 2);
+  ASSERT_EQ(truth[2].prim, 3);
+  const std::vector<Hit> hits = {{1e-7f, 3, 0, 0}, {0.5f, 2, 0, 0}, {0.25f, 3, 0, 0}};
+  const std::vector<std::int32_t> sources = {3, 3, 3};
+  AccuracyRow row;
+  judge_hits(referee, rays, truth, hits, sources, row);
+  EXPECT_DOUBLE_EQ(row.self_hits, 1.0 / 3);
+  EXPECT_DOUBLE_EQ(row.wrong_prim, 1.0 / 3);
+}
+
 TEST(Judge, OcclusionCanOnlyBeWrongAboutHitOrMiss) {
   const Scene scene = pair_and_floor();
   const Referee referee(scene);

@@ -52,6 +52,28 @@ TEST(Agreement, GivenTheGeometryCoincidentTrianglesAtDifferentFloatDistancesTie)
   EXPECT_EQ(compare_hits(out_of_scene, reference, rays, triangles).prim_ties, 0u);
 }
 
+TEST(Agreement, AnAnalyticPrimitiveTiesWhereTheRefereeTiesIt) {
+  // Ids: the floor triangle 0 (z = 0), a sphere 1 resting on the box's top
+  // (z from 1 to 2), the box 2 resting on the floor ([0, 1]^3).
+  const std::vector<Triangle> triangles{{{-5, -5, 0}, {5, -5, 0}, {0, 5, 0}}};
+  const std::vector<Sphere> spheres{{{0.25f, 0.25f, 1.5f}, 0.5f}};
+  const std::vector<BBox> boxes{{{0, 0, 0}, {1, 1, 1}}};
+  const PrimitiveSpans prims{triangles, spheres, boxes, {}};
+  const Ray up{{0.25f, 0.25f, -1}, 0, {0, 0, 1}};            // floor and box bottom at t = 1, sphere at t = 2
+  const Ray from_inside{{0.25f, 0.25f, 0.5f}, 0, {0, 0, 1}};  // box exit and sphere bottom at t = 0.5
+  const std::vector<Ray> rays{up, from_inside, up};
+  const std::vector<Hit> reference{{1.0f, 0, 0, 0}, {0.5f, 2, 0, 0}, {1.0f, 0, 0, 0}};
+  const std::vector<Hit> tested{{0x1.000002p+0f, 2, 0, 0},   // the box, one float ulp off: a tie
+                                {0x1.000002p-1f, 1, 0, 0},   // the sphere touching the box: a tie
+                                {2.0f, 1, 0, 0}};            // the sphere, farther: no tie
+  const Agreement a = compare_hits(tested, reference, rays, prims);
+  EXPECT_EQ(a.both_hit, 3u);
+  EXPECT_EQ(a.same_prim, 0u);
+  EXPECT_EQ(a.prim_ties, 2u);
+  // Given only the triangles, analytic ids are outside the scene: no exact ties.
+  EXPECT_EQ(compare_hits(tested, reference, rays, triangles).prim_ties, 0u);
+}
+
 TEST(Agreement, PercentileIgnoresTheRareOutlier) {
   std::vector<Hit> reference(2000, Hit{1.0f, 0, 0, 0}), tested = reference;
   tested[5].t = 2.0f;  // one ray in 2000: above the 99.9th percentile

@@ -373,5 +373,90 @@ TEST(ExactSphere, AgreesWithLongDoubleAwayFromTangency) {
   EXPECT_GT(compared, 15000);
 }
 
+
+// ---------------------------------------------------------------------------
+// Surface semantics (exact_intersect_surface): the analytic primitives of a
+// scene are crossed, not filled (prim/analytic_hit.h).
+
+TEST(ExactSurface, BoxEnteredFromOutsideAsTheSolid) {
+  const ExactPrimitiveHit h = exact_intersect_surface(make_ray({-4, 0.5f, 0.5f}, {1, 0, 0}), unit_box());
+  ASSERT_TRUE(h.hit);
+  EXPECT_EQ(h.t, 4.0);
+  EXPECT_FALSE(h.exit);
+  EXPECT_FALSE(h.start_contact);
+  // Entry beyond tfar: no crossing in the interval.
+  EXPECT_FALSE(exact_intersect_surface(make_ray({-4, 0.5f, 0.5f}, {1, 0, 0}, 0.0f, 3.5f), unit_box()).hit);
+  // tfar exactly at the entry: closed there.
+  EXPECT_TRUE(exact_intersect_surface(make_ray({-4, 0.5f, 0.5f}, {1, 0, 0}, 0.0f, 4.0f), unit_box()).hit);
+}
+
+TEST(ExactSurface, FromInsideTheExitOrNothing) {
+  const ExactPrimitiveHit h = exact_intersect_surface(make_ray({0.25f, 0.5f, 0.5f}, {1, 0, 0}), unit_box());
+  ASSERT_TRUE(h.hit);
+  EXPECT_TRUE(h.exit);
+  EXPECT_EQ(h.t, 0.75);
+  // Ending inside: the solid is hit (t = tfar), the surface is not crossed.
+  EXPECT_TRUE(exact_intersect(make_ray({0.25f, 0.5f, 0.5f}, {1, 0, 0}, 0.0f, 0.5f), unit_box()).hit);
+  EXPECT_FALSE(exact_intersect_surface(make_ray({0.25f, 0.5f, 0.5f}, {1, 0, 0}, 0.0f, 0.5f), unit_box()).hit);
+  EXPECT_TRUE(exact_intersect_surface(make_ray({0.25f, 0.5f, 0.5f}, {1, 0, 0}, 0.0f, 0.75f), unit_box()).hit);
+  // The same for an oriented box (a signed permutation of the axes: exact).
+  const OrientedBox b = obb({0, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, 0, -1}, {1, 2, 3});
+  const ExactPrimitiveHit o = exact_intersect_surface(make_ray({0, 0, 0}, {1, 0, 0}), b);
+  ASSERT_TRUE(o.hit);
+  EXPECT_TRUE(o.exit);
+  EXPECT_EQ(o.t, 2.0);
+  EXPECT_FALSE(exact_intersect_surface(make_ray({0, 0, 0}, {1, 0, 0}, 0.0f, 1.5f), b).hit);
+}
+
+TEST(ExactSurface, OriginOnTheSurfaceIsAContactHitOrMiss) {
+  // Inward from the face x = 1: the exit at x = 0, and the origin touches the surface.
+  const ExactPrimitiveHit in = exact_intersect_surface(make_ray({1, 0.5f, 0.5f}, {-1, 0, 0}), unit_box());
+  ASSERT_TRUE(in.hit);
+  EXPECT_TRUE(in.exit);
+  EXPECT_EQ(in.t, 1.0);
+  EXPECT_TRUE(in.start_contact);
+  const ExactPrimitiveHit out = exact_intersect_surface(make_ray({1, 0.5f, 0.5f}, {1, 0, 0}), unit_box());
+  EXPECT_FALSE(out.hit);
+  EXPECT_TRUE(out.start_contact);
+  // Sphere: roots 0 and 2 from the surface inward; solid-style exact_intersect
+  // reports no contact for the hit, the surface referee does.
+  EXPECT_FALSE(exact_intersect(make_ray({0, 0, 6}, {0, 0, -1}), kUnitAt5).start_contact);
+  const ExactPrimitiveHit s = exact_intersect_surface(make_ray({0, 0, 6}, {0, 0, -1}), kUnitAt5);
+  ASSERT_TRUE(s.hit);
+  EXPECT_TRUE(s.exit);
+  EXPECT_EQ(s.t, 2.0);
+  EXPECT_TRUE(s.start_contact);
+  EXPECT_FALSE(exact_intersect_surface(make_ray({0, 0, 7}, {0, 0, -1}), kUnitAt5).start_contact);
+}
+
+TEST(ExactSurface, AgreesWithTheSolidReadAsTwoCrossings) {
+  // The plan's reading: the solid asked with tfar = inf gives the first
+  // crossing after lo; it counts when it is <= tfar. Random rays with
+  // random intervals through random boxes, both ways.
+  int hits = 0, ends_inside = 0;
+  for (std::uint64_t i = 0; i < 4000; ++i) {
+    Rng rng(3, 0, i);
+    const auto u = [&] { return static_cast<float>(rng.next_double() * 4.0 - 2.0); };
+    const BBox box{{-1, -0.5f, -0.25f}, {1, 0.5f, 0.25f}};
+    // Origins around the box, often inside it; intervals often ending inside.
+    const Vec3f org{0.75f * u(), 0.375f * u(), 0.2f * u()};
+    Ray r = make_ray(org, {u(), u(), u()}, 0.0f, static_cast<float>(rng.next_double()));
+    Ray unbounded = r;
+    unbounded.tfar = kInf;
+    const ExactPrimitiveHit solid = exact_intersect(unbounded, box);
+    const bool expected = solid.hit && solid.t <= r.tfar;
+    const ExactPrimitiveHit surface = exact_intersect_surface(r, box);
+    ASSERT_EQ(surface.hit, expected) << i;
+    if (expected) {
+      EXPECT_EQ(surface.t, solid.t) << i;
+      EXPECT_EQ(surface.exit, solid.exit) << i;
+    }
+    hits += expected;
+    ends_inside += exact_intersect(r, box).hit && !expected;
+  }
+  EXPECT_GT(hits, 200);
+  EXPECT_GT(ends_inside, 50) << "segments inside the solid, which the surface reading misses";
+}
+
 }  // namespace
 }  // namespace raybench

@@ -206,6 +206,50 @@ TEST(Npy, EmptyFloat64MatrixRoundTrips) {
   EXPECT_EQ(columns, 4u);
 }
 
+// Scene primitive files (scene/analytic_files.h) come as float32 or float64.
+TEST(Npy, RealMatricesReadAsDoublesFromFloat32AndFloat64) {
+  TempDir dir;
+  const float f[6] = {1.5f, -2.0f, 0x1.000002p+0f, 3.0f, 1e30f, -0.0f};
+  const std::string f4 = dir.write("f4.npy", npy_bytes("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }", 0) +
+                                                 std::string(reinterpret_cast<const char*>(f), sizeof f));
+  std::size_t rows = 0;
+  const std::vector<double> a = read_npy_real(f4, 3, "test", rows);
+  EXPECT_EQ(rows, 2u);
+  EXPECT_EQ(a, std::vector<double>(f, f + 6));  // float32 widens exactly
+  const std::vector<double> d{1e300, 2, 3, 4, 5, 6};
+  write_npy_f64(dir.file("f8.npy"), d, 3, 2);
+  EXPECT_EQ(read_npy_real(dir.file("f8.npy"), 2, "test", rows), d);
+  EXPECT_EQ(rows, 3u);
+  write_npy_f64(dir.file("empty.npy"), {}, 0, 4);
+  EXPECT_TRUE(read_npy_real(dir.file("empty.npy"), 4, "test", rows).empty());
+  EXPECT_EQ(rows, 0u);
+}
+
+TEST(Npy, RealMatricesOfAnotherDtypeOrShapeAreRefusedNamingTheFileAndWhatItShouldHold) {
+  TempDir dir;
+  const struct {
+    const char* dict;
+    std::size_t body;
+    const char* problem;
+  } cases[] = {
+      {"{'descr': '<i8', 'fortran_order': False, 'shape': (1, 4), }", 32, "dtype is '<i8', expected float32 or float64"},
+      {"{'descr': '>f8', 'fortran_order': False, 'shape': (1, 4), }", 32, "dtype is '>f8'"},
+      {"{'descr': '<f2', 'fortran_order': False, 'shape': (1, 4), }", 8, "dtype is '<f2'"},
+      {"{'descr': '<f8', 'fortran_order': False, 'shape': (4,), }", 32, "shape is (4,), expected (N, 4) (spheres: cx cy cz r)"},
+      {"{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }", 24, "shape is (2, 3), expected (N, 4)"},
+      {"{'descr': '<f4', 'fortran_order': False, 'shape': (1, 4, 1), }", 16, "shape is (1, 4, 1)"},
+      {"{'descr': '<f4', 'fortran_order': True, 'shape': (2, 4), }", 32, "Fortran order"},
+      {"{'descr': '<f8', 'fortran_order': False, 'shape': (2, 4), }", 40, "truncated"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = dir.write("bad.npy", npy_bytes(c.dict, c.body));
+    std::size_t rows = 0;
+    const std::string error = testing::input_error_of([&] { read_npy_real(path, 4, "spheres: cx cy cz r", rows); });
+    EXPECT_NE(error.find(path), std::string::npos) << error;
+    EXPECT_NE(error.find(c.problem), std::string::npos) << c.dict << ": " << error;
+  }
+}
+
 TEST(Npy, AFailedWriteLeavesNoFileBehind) {
   TempDir dir;
   std::filesystem::create_directories(dir.file("occupied.npy"));  // a directory where the file should go

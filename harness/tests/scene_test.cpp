@@ -2,7 +2,10 @@
 // show, every triangle of the file kept, one documented order.
 #include "scene/scene.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <map>
 #include <tuple>
 
@@ -280,6 +283,106 @@ TEST(ProceduralScenes, TheSphereIsClosed) {
     }
   }
   for (const auto& [edge, count] : edges) EXPECT_EQ(count, 2);
+}
+
+// Issue 31: the same terrain and the same balls, analytic after the terrain's
+// triangles; the tessellated scene is unchanged (its stored ray sets stay valid).
+TEST(ProceduralScenes, TheAnalyticTerrainHasTheSameTerrainAndTheBallsTheUvSpheresStandFor) {
+  for (const auto& [tessellated_name, analytic_name, terrain, balls] :
+       {std::tuple{"proc:terrain_spheres_small", "proc:terrain_spheres_analytic_small", 2048u, 6u},
+        std::tuple{"proc:terrain_spheres", "proc:terrain_spheres_analytic", 524288u, 120u}}) {
+    const Scene tessellated = load_scene(tessellated_name);
+    const Scene analytic = load_scene(analytic_name);
+    ASSERT_EQ(analytic.triangles.size(), terrain) << analytic_name;
+    ASSERT_EQ(analytic.spheres.size(), balls) << analytic_name;
+    EXPECT_TRUE(analytic.boxes.empty() && analytic.obbs.empty());
+    EXPECT_EQ(std::memcmp(analytic.triangles.data(), tessellated.triangles.data(), terrain * sizeof(Triangle)), 0);
+    // Each ball's UV sphere (the triangles after the terrain, ball by ball)
+    // has its vertices on the analytic sphere, to float rounding.
+    const std::size_t per_ball = (tessellated.triangles.size() - terrain) / balls;
+    ASSERT_EQ(terrain + per_ball * balls, tessellated.triangles.size());
+    for (std::size_t k = 0; k < balls; ++k) {
+      const Sphere& s = analytic.spheres[k];
+      for (std::size_t i = terrain + k * per_ball; i < terrain + (k + 1) * per_ball; ++i)
+        for (const Vec3f& v : {tessellated.triangles[i].v0, tessellated.triangles[i].v1, tessellated.triangles[i].v2})
+          ASSERT_NEAR(length(v - s.center), s.radius, 1e-4f * (s.radius + length(s.center))) << analytic_name << " ball " << k;
+    }
+  }
+}
+
+TEST(ProceduralScenes, TheAnalyticScenesAreDeterministicAndOfTheDocumentedSize) {
+  const Scene field = load_scene("proc:sphere_field");
+  EXPECT_EQ(field.triangles.size(), 0u);
+  EXPECT_EQ(field.spheres.size(), 4176u);
+  EXPECT_EQ(field.content_hash(), load_scene("proc:sphere_field").content_hash());
+  const Scene mix = load_scene("proc:analytic_mix");
+  EXPECT_EQ(mix.triangles.size(), 36u);
+  EXPECT_EQ(mix.spheres.size(), 8u);
+  EXPECT_EQ(mix.boxes.size(), 6u);
+  EXPECT_EQ(mix.obbs.size(), 6u);
+  EXPECT_EQ(mix.content_hash(), load_scene("proc:analytic_mix").content_hash());
+  EXPECT_NE(mix.content_hash(), field.content_hash());
+}
+
+// What issue 31 asks of the many-spheres scene: radii and distances over
+// many orders of magnitude, small and far, huge and near, overlapping, nested.
+TEST(ProceduralScenes, TheSphereFieldHasSmallAndFarHugeAndNearOverlappingAndNestedSpheres) {
+  const Scene field = load_scene("proc:sphere_field");
+  float r_min = INFINITY, r_max = 0.0f;
+  std::size_t small_far = 0, huge_near = 0, overlapping = 0, nested = 0, concentric = 0;
+  for (std::size_t i = 0; i < field.spheres.size(); ++i) {
+    const Sphere& a = field.spheres[i];
+    r_min = std::min(r_min, a.radius);
+    r_max = std::max(r_max, a.radius);
+    const float distance = length(a.center);  // of the centre from the origin
+    small_far += a.radius < 1e-2f && distance > 1e3f;
+    huge_near += a.radius >= 1e3f && distance - a.radius < 100.0f;  // its surface within 100 of the origin
+  }
+  // Pairs among the clusters and nests (the spheres after the specks), in double.
+  for (std::size_t i = 3504; i < field.spheres.size(); ++i) {
+    for (std::size_t j = i + 1; j < field.spheres.size(); ++j) {
+      const Sphere& a = field.spheres[i];
+      const Sphere& b = field.spheres[j];
+      const double dx = double(a.center.x) - b.center.x, dy = double(a.center.y) - b.center.y,
+                   dz = double(a.center.z) - b.center.z;
+      const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+      if (d + b.radius < a.radius) {
+        ++nested;
+        concentric += d == 0.0;
+      } else if (d < a.radius + b.radius) {
+        ++overlapping;
+      }
+    }
+  }
+  EXPECT_LE(r_min, 1.1e-3f);
+  EXPECT_EQ(r_max, 1e5f);
+  EXPECT_GE(small_far, 400u);
+  EXPECT_EQ(huge_near, 4u);  // the ground and the three walls of radius 1e3
+  EXPECT_GE(overlapping, 1000u);  // most of the 64 x 28 pairs within clusters: their surfaces cross
+  EXPECT_GE(nested, 32u * 10u);                // every pair within a nest, at least
+  EXPECT_EQ(concentric, 10u);                  // the first nest
+  // The manifests' camera stands outside every sphere.
+  const Vec3f camera{0.0f, 12.0f, 90.0f};
+  for (const Sphere& s : field.spheres) EXPECT_GT(length(camera - s.center), s.radius);
+}
+
+TEST(ProceduralScenes, TheMixHasEveryTypeAndRotatedOrientedBoxes) {
+  const Scene mix = load_scene("proc:analytic_mix");
+  for (const OrientedBox& o : mix.obbs) {
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(dot(o.axis[k], o.axis[k]), 1.0f, 1e-6f);
+      EXPECT_NEAR(dot(o.axis[k], o.axis[(k + 1) % 3]), 0.0f, 1e-6f);
+      // Not near any coordinate axis: a rotation the slab test would not get right.
+      EXPECT_LT(std::max({std::fabs(o.axis[k].x), std::fabs(o.axis[k].y), std::fabs(o.axis[k].z)}), 0.99f);
+    }
+  }
+  EXPECT_EQ(mix.boxes[1].upper.x, mix.boxes[2].lower.x);  // two boxes share a face
+  const PrimitiveSpans all = mix.primitives();
+  EXPECT_EQ(all.kind(35), PrimitiveKind::kTriangle);
+  EXPECT_EQ(all.kind(36), PrimitiveKind::kSphere);
+  EXPECT_EQ(all.kind(44), PrimitiveKind::kBox);
+  EXPECT_EQ(all.kind(50), PrimitiveKind::kOrientedBox);
+  EXPECT_EQ(all.size(), 56u);
 }
 
 TEST(ProceduralScenes, UnknownNamesListTheKnownOnes) {

@@ -9,6 +9,7 @@
 
 #include "build_info.h"
 #include "io/error.h"
+#include "io/npy.h"
 #include "raybench/variants.h"
 #include "suite/results_table.h"
 #include "suite/scene_selection.h"
@@ -437,6 +438,160 @@ TEST(Suite, ANameGivenOnTheCommandLineObeysTheSceneNameRule) {
   EXPECT_EQ(selection_error({"ball=proc:sphere", "ball=proc:terrain_spheres_small"}, suite),
             "--scene: ball=proc:sphere and ball=proc:terrain_spheres_small both name the scene 'ball' (their rows and "
             "ray files would collide): name one of them, e.g. --scene ball_2=proc:terrain_spheres_small");
+}
+
+// --- Analytic primitives (issue 31): spheres, boxes, obbs = "FILE.npy".
+
+// A float64 .npy of the given rows under `dir`.
+std::string primitive_file(const TempDir& dir, const std::string& name, const std::vector<double>& values,
+                           std::size_t columns) {
+  std::filesystem::create_directories(std::filesystem::path(dir.file(name)).parent_path());
+  write_npy_f64(dir.file(name), values, values.size() / columns, columns);
+  return dir.file(name);
+}
+
+const std::vector<double> kOneObb{5, 0, 0, 0, 0, 1, 0, 1, 0, -1, 0, 0, 1, 2, 3};  // axes (z, y, -x)
+
+TEST(Suite, PrimitiveFilesAreResolvedAgainstTheManifestAndFollowTheMeshInPrimIds) {
+  TempDir dir;
+  primitive_file(dir, "prims/s.npy", {0, 0, 0, 1, 3, 0, 0, 0.5}, 4);
+  primitive_file(dir, "prims/b.npy", {0, 0, 0, 1, 1, 1}, 6);
+  primitive_file(dir, "prims/o.npy", kOneObb, 15);
+  const Suite s = load_suite(dir.write("s.toml", "[[scene]]\nname = \"mix\"\npath = \"proc:sphere\"\n"
+                                                 "spheres = \"prims/s.npy\"\nboxes = \"prims/b.npy\"\n"
+                                                 "obbs = \"prims/o.npy\"\n"
+                                                 "[[scene]]\nname = \"balls\"\nspheres = \"prims/s.npy\"\n"));
+  const SuiteScene& mix = s.scenes[0];
+  EXPECT_EQ(mix.spheres, dir.file("prims/s.npy"));
+  EXPECT_EQ(mix.boxes, dir.file("prims/b.npy"));
+  EXPECT_EQ(mix.obbs, dir.file("prims/o.npy"));
+  EXPECT_TRUE(mix.available());
+  EXPECT_EQ(mix.sources(), fmt::format("proc:sphere + spheres {} + boxes {} + obbs {}", mix.spheres, mix.boxes, mix.obbs));
+  const Scene scene = load_suite_scene(mix);
+  EXPECT_EQ(scene.name, "mix");
+  EXPECT_EQ(scene.triangles.size(), 2208u);  // proc:sphere's
+  ASSERT_EQ(scene.spheres.size(), 2u);
+  EXPECT_EQ(scene.spheres[1].center.x, 3.0f);
+  ASSERT_EQ(scene.boxes.size(), 1u);
+  ASSERT_EQ(scene.obbs.size(), 1u);
+  EXPECT_EQ(scene.obbs[0].axis[2].x, -1.0f);
+  const PrimitiveSpans all = scene.primitives();
+  EXPECT_EQ(all.kind(2208), PrimitiveKind::kSphere);
+  EXPECT_EQ(all.kind(2210), PrimitiveKind::kBox);
+  EXPECT_EQ(all.kind(2211), PrimitiveKind::kOrientedBox);
+  EXPECT_EQ(describe_primitives(scene), "2208 triangles, 2 spheres, 1 box, 1 oriented box");
+  // A scene of primitive files alone: no path, no triangles.
+  const Scene balls = load_suite_scene(s.scenes[1]);
+  EXPECT_EQ(balls.triangles.size(), 0u);
+  EXPECT_EQ(balls.spheres.size(), 2u);
+  EXPECT_EQ(s.scenes[1].path, "");
+  EXPECT_EQ(s.scenes[1].sources(), "spheres " + dir.file("prims/s.npy"));
+}
+
+TEST(Suite, AScaleAndOffsetMoveAnalyticPrimitivesAndScaleTheirSizes) {
+  TempDir dir;
+  primitive_file(dir, "s.npy", {1, 2, 3, 0.5}, 4);
+  primitive_file(dir, "b.npy", {-1, -1, -1, 1, 2, 3}, 6);
+  primitive_file(dir, "o.npy", kOneObb, 15);
+  const Suite s = load_suite(dir.write("s.toml", "[[scene]]\nname = \"m\"\nspheres = \"s.npy\"\nboxes = \"b.npy\"\n"
+                                                 "obbs = \"o.npy\"\nscale = 2.0\noffset = [10, 0, -1]\n"));
+  const Scene scene = load_suite_scene(s.scenes[0]);
+  EXPECT_EQ(scene.spheres[0].center.x, 12.0f);
+  EXPECT_EQ(scene.spheres[0].center.z, 5.0f);
+  EXPECT_EQ(scene.spheres[0].radius, 1.0f);
+  EXPECT_EQ(scene.boxes[0].lower.x, 8.0f);
+  EXPECT_EQ(scene.boxes[0].upper.z, 5.0f);
+  EXPECT_EQ(scene.obbs[0].center.x, 20.0f);
+  EXPECT_EQ(scene.obbs[0].half_extent.z, 6.0f);
+  EXPECT_EQ(scene.obbs[0].axis[0].z, 1.0f);  // axes are directions: kept
+}
+
+TEST(Suite, AnAnalyticPrimitiveMovedBeyondTheCoordinateLimitIsRefusedNamingTheSceneAndThePrimitive) {
+  TempDir dir;
+  primitive_file(dir, "s.npy", {0, 0, 0, 1, 0, 0, 0, 4}, 4);
+  const Suite s = load_suite(dir.write("s.toml", "[[scene]]\nname = \"m\"\nspheres = \"s.npy\"\nscale = 3e17\n"));
+  const std::string error = testing::input_error_of([&] { load_suite_scene(s.scenes[0]); });
+  EXPECT_NE(error.find("scene 'm' (spheres " + dir.file("s.npy") + " with the manifest's scale and offset): sphere 1 "
+                       "(prim 1) reaches a coordinate of -1.2e+18"), std::string::npos) << error;
+}
+
+TEST(Suite, AMalformedPrimitiveFileIsRefusedWhenTheSceneLoadsNamingTheFileAndTheRow) {
+  TempDir dir;
+  const std::string file = primitive_file(dir, "s.npy", {0, 0, 0, 1, 0, 0, 0, -2}, 4);
+  const Suite s = load_suite(dir.write("s.toml", "[[scene]]\nname = \"m\"\npath = \"proc:sphere\"\nspheres = \"s.npy\"\n"));
+  EXPECT_EQ(testing::input_error_of([&] { load_suite_scene(s.scenes[0]); }), file + ": row 1: radius is -2: it must be >= 0");
+}
+
+TEST(Suite, ASceneOfEmptyPrimitiveFilesHoldsNothingToTraceAndIsRefused) {
+  TempDir dir;
+  primitive_file(dir, "s.npy", {}, 4);
+  const Suite s = load_suite(dir.write("s.toml", "[[scene]]\nname = \"m\"\nspheres = \"s.npy\"\n"));
+  EXPECT_EQ(testing::input_error_of([&] { load_suite_scene(s.scenes[0]); }),
+            "scene 'm' (spheres " + dir.file("s.npy") + "): holds no primitives (its files have 0 rows): nothing to trace");
+}
+
+TEST(Suite, AMissingPrimitiveFileMakesTheSceneUnavailableAndIsNamed) {
+  TempDir dir;
+  primitive_file(dir, "s.npy", {0, 0, 0, 1}, 4);
+  const Suite s = load_suite(dir.write("s.toml", "[[scene]]\nname = \"m\"\npath = \"proc:sphere\"\nspheres = \"s.npy\"\n"
+                                                 "boxes = \"absent.npy\"\noptional = true\n"));
+  EXPECT_FALSE(s.scenes[0].available());
+  EXPECT_EQ(s.scenes[0].missing(), dir.file("absent.npy"));
+}
+
+TEST(Suite, PrimitiveKeysAreStringsNamingNpyFiles) {
+  TempDir dir;
+  const struct {
+    const char* text;
+    const char* problem;
+  } cases[] = {
+      {"[[scene]]\nname = \"a\"\nspheres = 3\n", "'scene[0].spheres': expected a string"},
+      {"[[scene]]\nname = \"a\"\nboxes = \"\"\n", "'scene[0].boxes': is empty"},
+      {"[[scene]]\nname = \"a\"\nobbs = \"proc:sphere\"\n",
+       "'scene[0].obbs': 'proc:sphere' is a procedural scene's name; obbs names a .npy file"},
+      {"[[scene]]\nname = \"a\"\ncones = \"c.npy\"\n", "'scene[0].cones': unknown key"},
+      {"[[scene]]\nname = \"a\"\n", "needs a name and a path (a mesh or proc:<name>), or analytic primitives"},
+  };
+  int i = 0;
+  for (const auto& c : cases) {
+    const auto path = dir.write("bad" + std::to_string(i++) + ".toml", c.text);
+    const std::string error = error_of(path);
+    EXPECT_NE(error.find(path), std::string::npos) << error;
+    EXPECT_NE(error.find(c.problem), std::string::npos) << "expected '" << c.problem << "' in: " << error;
+  }
+}
+
+// Issue 31: "The default suite and the accuracy suite include an analytic scene."
+TEST(Suite, TheDefaultProceduralAndAccuracySuitesIncludeAnalyticScenes) {
+  const auto analytic = [](const char* manifest, const char* name) {
+    const Suite s = load_suite(std::string(RAYBENCH_SOURCE_DIR) + "/meshes/" + manifest);
+    const SuiteScene* entry = s.find(name);
+    return entry && entry->available() && load_suite_scene(*entry).has_analytic();
+  };
+  EXPECT_TRUE(analytic("default.toml", "terrain_spheres_analytic"));
+  EXPECT_TRUE(analytic("procedural.toml", "terrain_spheres_analytic"));
+  EXPECT_TRUE(analytic("procedural.toml", "terrain_spheres_analytic_small"));
+  EXPECT_TRUE(analytic("accuracy.toml", "analytic_mix"));
+  EXPECT_TRUE(analytic("accuracy.toml", "sphere_field"));
+  // The tessellated terrain stays beside its analytic twin, for comparison.
+  EXPECT_FALSE(analytic("default.toml", "terrain_spheres"));
+}
+
+// A camera or light inside a sphere would see (or be shadowed by) its inside only.
+TEST(Suite, TheAnalyticScenesCamerasAndLightsStandOutsideEveryPrimitive) {
+  const Suite s = load_suite(std::string(RAYBENCH_SOURCE_DIR) + "/meshes/accuracy.toml");
+  const SuiteScene* entry = s.find("sphere_field");
+  ASSERT_TRUE(entry && entry->camera && entry->light);
+  for (const Sphere& b : load_suite_scene(*entry).spheres) {
+    EXPECT_GT(length(entry->camera->position - b.center), b.radius);
+    EXPECT_GT(length(*entry->light - b.center), b.radius);
+  }
+  // The mix's camera and light stand above all of it.
+  const SuiteScene* mix = s.find("analytic_mix");
+  ASSERT_TRUE(mix && mix->camera && mix->light);
+  const float top = load_suite_scene(*mix).bounds().upper.y;
+  EXPECT_GT(mix->camera->position.y, top);
+  EXPECT_GT(mix->light->y, top);
 }
 
 // --- The results table (suite/results_table.h).

@@ -16,8 +16,10 @@
 
 namespace raybench {
 
-// What a backend can model natively. Only triangles exist today; analytic
-// spheres and boxes arrive with scene manifests that name them.
+// What a backend can model natively: the primitive types of a scene
+// (raybench/prim/primitives.h) it traces as they are. A run skips a backend
+// for a scene with a type it lacks (with a note: suite/suite_run.h), never
+// tessellating silently; plugins model triangles only.
 struct Capabilities {
   bool triangles = true;
   bool spheres = false;
@@ -25,6 +27,10 @@ struct Capabilities {
   bool oriented_boxes = false;
   bool intersect = true;  // false for occlusion-only backends
 };
+
+// The primitive types `scene` has and `capabilities` lacks, in prim-id order
+// ("spheres and oriented boxes"); "" when the backend can model the scene.
+std::string missing_primitive_types(const Capabilities& capabilities, const Scene& scene);
 
 struct BackendConfig {
   int threads = 1;  // threads a backend may use to build
@@ -108,6 +114,11 @@ bool register_backend_family(std::string family, int order, BackendFactory make,
 // Makes a backend from "family[:option[:option...]]", e.g. "embree:high:robust"
 // or "bvh2:mt". Throws InputError naming an unknown family or option.
 std::unique_ptr<Backend> make_backend(const std::string& name, const BackendConfig& config = {});
+
+// Why `backend` cannot trace `scene`, as one line, e.g. "backend 'plugin:x.so'
+// models triangles only; scene 'mix' has spheres and boxes"; "" when it can
+// (missing_primitive_types is empty).
+std::string capability_problem(const Backend& backend, const Scene& scene);
 
 // Every name make_backend accepts in its canonical forms, for --help.
 std::vector<BackendInfo> list_backends();

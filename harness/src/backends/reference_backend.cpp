@@ -1,7 +1,8 @@
 // "reference": the exact referee (referee/referee.h) as a backend, so that it
 // runs wherever a backend runs (raybench trace, run) and its answers can be
 // stored and compared like any other. It is the truth of the accuracy report
-// and slow on purpose: every candidate triangle is judged exactly.
+// and slow on purpose: every candidate primitive is judged exactly. It models
+// every primitive type (analytic ones as surfaces, prim/analytic_hit.h).
 #include <cmath>
 
 #include <fmt/format.h>
@@ -19,17 +20,26 @@ class ReferenceBackend final : public Backend {
 
   const std::string& name() const override { return name_; }
 
+  Capabilities capabilities() const override {
+    Capabilities c;
+    c.spheres = c.boxes = c.oriented_boxes = true;
+    return c;
+  }
+
   void build(const Scene& scene) override {
-    scene_ = scene;  // the referee keeps a reference: own the triangles
+    scene_ = scene;  // the referee keeps a reference: own the primitives
     referee_ = std::make_unique<Referee>(scene_);
   }
 
   std::size_t memory_bytes() const override {
-    return referee_ ? referee_->memory_bytes() + scene_.triangles.size() * sizeof(Triangle) : 0;
+    return referee_ ? referee_->memory_bytes() + scene_.triangles.size() * sizeof(Triangle) +
+                          scene_.spheres.size() * sizeof(Sphere) + scene_.boxes.size() * sizeof(BBox) +
+                          scene_.obbs.size() * sizeof(OrientedBox)
+                    : 0;
   }
 
   // t is the float nearest the exact t (barring a double-rounding tie); u, v are the barycentrics of the
-  // exact hit point, computed in double (approximate).
+  // exact hit point, computed in double (approximate), for triangles; 0 for analytic hits.
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
     for (std::size_t i = 0; i < rays.size(); ++i) {
       const RefereeVerdict v = referee_->judge(rays[i]);
@@ -37,7 +47,8 @@ class ReferenceBackend final : public Backend {
       if (!v.hit()) continue;
       hits[i].t = static_cast<float>(v.t);
       hits[i].prim = v.prim;
-      barycentrics(rays[i], scene_.triangles[v.prim], v.t, hits[i]);
+      if (static_cast<std::size_t>(v.prim) < scene_.triangles.size())
+        barycentrics(rays[i], scene_.triangles[v.prim], v.t, hits[i]);
     }
   }
 
@@ -72,7 +83,7 @@ std::unique_ptr<Backend> make_reference_backend(const std::string& name, const s
 }
 
 std::vector<BackendInfo> reference_backend_names() {
-  return {{"reference", "exact referee: our BVH2 with conservative traversal, every candidate judged in exact arithmetic (CGAL, GMP)",
+  return {{"reference", "exact referee: our BVH2 with conservative traversal, every candidate (triangle, sphere, box, OBB) judged in exact arithmetic (CGAL, GMP, MPFR)",
            "exact"}};
 }
 

@@ -452,8 +452,8 @@ int run(int argc, char** argv) {
       const bool suite_camera = c.entry && c.entry->camera;
       const Camera cam = suite_camera ? *c.entry->camera : RayGenerator(scene).default_camera();
       const auto v = [](Vec3f p) { return fmt::format("({:.6g}, {:.6g}, {:.6g})", p.x, p.y, p.z); };
-      fmt::print("{}: {} triangles\n  bounds {} - {}, size {}\n  camera ({}) position {} look_at {} up {} fov {:.6g}\n",
-                 printable(scene.name), scene.triangles.size(), v(b.lower), v(b.upper), v(b.upper - b.lower),
+      fmt::print("{}: {}\n  bounds {} - {}, size {}\n  camera ({}) position {} look_at {} up {} fov {:.6g}\n",
+                 printable(scene.name), describe_primitives(scene), v(b.lower), v(b.upper), v(b.upper - b.lower),
                  suite_camera ? "the suite's" : "default: frames the bounds from outside", v(cam.position),
                  v(cam.look_at), v(cam.up), cam.fov_degrees);
     }
@@ -462,10 +462,14 @@ int run(int argc, char** argv) {
   if (*scenes_cmd || (*run_cmd && list_only)) {
     const Suite suite = load_suite(*scenes_cmd ? scenes_suite : suite_path);
     fmt::print("suite {}:\n", suite.path);
+    std::size_t width = 18;  // names aligned in one column, however long the longest
+    for (const SuiteScene& s : suite.scenes) width = std::max(width, s.name.size());
     for (const SuiteScene& s : suite.scenes)
-      fmt::print("  {:<18} {:<9} {}\n", s.name, s.available() ? "available" : "missing", s.path);
+      fmt::print("  {:<{}} {:<9} {}\n", s.name, width, s.available() ? "available" : "missing", s.sources());
     fmt::print("procedural scenes (use as proc:<name>):\n");
-    for (const ProceduralSceneInfo& p : procedural_scenes()) fmt::print("  {:<22} {}\n", p.name, p.description);
+    width = 22;
+    for (const ProceduralSceneInfo& p : procedural_scenes()) width = std::max(width, p.name.size());
+    for (const ProceduralSceneInfo& p : procedural_scenes()) fmt::print("  {:<{}} {}\n", p.name, width, p.description);
     return 0;
   }
   if (*run_cmd) {
@@ -537,8 +541,8 @@ int run(int argc, char** argv) {
                     s.entry ? s.entry->light : std::nullopt, s.entry ? s.entry->inside : std::nullopt};
     const std::vector<Ray> rays = generator.generate(spec);
     write_ray_file(rays_out, rays);
-    fmt::print("wrote {} {} rays for {} ({} triangles) to {}\n", rays.size(), rays_kind, s.scene.name,
-               s.scene.triangles.size(), rays_out);
+    fmt::print("wrote {} {} rays for {} ({}) to {}\n", rays.size(), rays_kind, s.scene.name,
+               describe_primitives(s.scene), rays_out);
     return 0;
   }
   if (*trace_cmd) {
@@ -554,6 +558,9 @@ int run(int argc, char** argv) {
     const ScreenedRays screened = screen_rays(read_ray_file(trace_rays));
     const std::vector<Ray>& rays = screened.rays;
     const SceneArg s = resolve_scene(trace_scene, suite);
+    // A run skips such a pair with a note; tracing one explicitly is bad usage.
+    if (const std::string problem = capability_problem(*backend, s.scene); !problem.empty())
+      throw InputError("--backend", problem + " (raybench run skips such a pair)");
     const TraceExecutor executor(threads);
     executor.run([&] { backend->build(s.scene); });
     std::size_t hits = 0;
@@ -567,7 +574,7 @@ int run(int argc, char** argv) {
                  rays.size(), trace_out);
     } else {
       const std::vector<Hit> h = executor.answers(*backend, screened);
-      require_valid_hits(*backend, h, s.scene.triangles.size(), fmt::format("{} ({})", s.scene.name, trace_rays));
+      require_valid_hits(*backend, h, s.scene.primitive_count(), fmt::format("{} ({})", s.scene.name, trace_rays));
       std::vector<double> out(rays.size() * 4);
       for (std::size_t i = 0; i < h.size(); ++i) {
         out[4 * i + 0] = h[i].t;

@@ -118,7 +118,7 @@ std::string shape_string(const std::vector<std::size_t>& shape) {
 
 // Reads a 2-D array of `columns` columns and element type `descr`.
 std::vector<char> read_matrix(const std::string& path, const char* descr, std::size_t element_size,
-                              std::size_t columns, const char* what, std::size_t& rows) {
+                              std::size_t columns, const std::string& what, std::size_t& rows) {
   check_input_file(path, ".npy file");
   std::error_code ec;
   std::ifstream in(path, std::ios::binary);
@@ -200,6 +200,31 @@ std::vector<double> read_npy_f64(const std::string& path, std::size_t& rows, std
   std::vector<double> out(rows * columns);
   if (!body.empty()) std::memcpy(out.data(), body.data(), body.size());
   return out;
+}
+
+std::vector<double> read_npy_real(const std::string& path, std::size_t columns, const std::string& what,
+                                  std::size_t& rows) {
+  check_input_file(path, ".npy file");
+  std::string descr;
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, "cannot be opened for reading");
+    descr = read_header(in, path).descr;
+  }
+  if (descr == "<f4") {
+    const std::vector<char> body = read_matrix(path, "<f4", sizeof(float), columns, what, rows);
+    std::vector<float> values(rows * columns);
+    if (!body.empty()) std::memcpy(values.data(), body.data(), body.size());
+    return std::vector<double>(values.begin(), values.end());
+  }
+  if (descr == "<f8") {
+    const std::vector<char> body = read_matrix(path, "<f8", sizeof(double), columns, what, rows);
+    std::vector<double> out(rows * columns);
+    if (!body.empty()) std::memcpy(out.data(), body.data(), body.size());
+    return out;
+  }
+  throw InputError(path, fmt::format("dtype is '{}', expected float32 or float64 ('<f4' or '<f8', little-endian) ({})",
+                                     descr, what));
 }
 
 }  // namespace raybench

@@ -27,4 +27,12 @@ void write_npy_f64(const std::string& path, std::span<const double> data, std::s
 // Reads float64 data of shape (rows, columns); used by tests and tools.
 std::vector<double> read_npy_f64(const std::string& path, std::size_t& rows, std::size_t& columns);
 
+// Reads a float32 or float64 array of shape (N, columns) as doubles (float32
+// values widen exactly), row-major; sets `rows` to N. `what` says what the
+// file holds, for the messages, e.g. "spheres: cx cy cz r". Throws InputError
+// naming the file for any other dtype, a shape other than (N, columns), and
+// everything read_ray_file refuses.
+std::vector<double> read_npy_real(const std::string& path, std::size_t columns, const std::string& what,
+                                  std::size_t& rows);
+
 }  // namespace raybench

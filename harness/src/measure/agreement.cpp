@@ -1,6 +1,7 @@
 // Per-ray agreement of a backend with a reference (measure/agreement.h):
-// hit/miss, triangle and t compared ray by ray; a different triangle at the
-// same float t, or at the same exact t, is counted as a tie as well.
+// hit/miss, primitive and t compared ray by ray; a different primitive at
+// the same float t, or at the same t as the referee ties hits, is counted as
+// a tie as well.
 #include "measure/agreement.h"
 
 #include <algorithm>
@@ -8,7 +9,7 @@
 #include <limits>
 #include <vector>
 
-#include "referee/exact_triangle.h"
+#include "referee/referee.h"
 
 namespace raybench {
 
@@ -21,9 +22,14 @@ double nearest_rank_percentile(std::vector<double>& values, double p) {
 
 Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference, std::span<const Ray> rays,
                        std::span<const Triangle> triangles) {
-  const bool exact_ties = !rays.empty() && !triangles.empty();
+  return compare_hits(tested, reference, rays, PrimitiveSpans{triangles, {}, {}, {}});
+}
+
+Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference, std::span<const Ray> rays,
+                       const PrimitiveSpans& prims) {
+  const bool exact_ties = !rays.empty() && prims.size() > 0;
   // A prim outside the scene (a backend's bug) is never a tie, and never indexes past it.
-  const auto in_scene = [&](std::int32_t prim) { return prim >= 0 && static_cast<std::size_t>(prim) < triangles.size(); };
+  const auto in_scene = [&](std::int32_t prim) { return prim >= 0 && static_cast<std::size_t>(prim) < prims.size(); };
   Agreement a;
   a.has_prims = true;
   a.rays = tested.size();
@@ -38,8 +44,7 @@ Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> referen
     ++a.both_hit;
     if (t.prim == r.prim) ++a.same_prim;
     else if (t.t == r.t || (exact_ties && in_scene(t.prim) && in_scene(r.prim) &&
-                            same_exact_t(rays[i], triangles[static_cast<std::size_t>(t.prim)],
-                                         triangles[static_cast<std::size_t>(r.prim)])))
+                            same_t(rays[i], prims, static_cast<std::size_t>(t.prim), static_cast<std::size_t>(r.prim))))
       ++a.prim_ties;
     const double diff = std::fabs(static_cast<double>(t.t) - r.t);
     relerr.push_back(r.t != 0.0f ? diff / std::fabs(static_cast<double>(r.t)) : diff);

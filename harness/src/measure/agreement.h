@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "raybench/math/ray.h"
+#include "raybench/prim/primitives.h"
 #include "raybench/prim/triangle.h"
 
 namespace raybench {
@@ -45,6 +46,12 @@ double nearest_rank_percentile(std::vector<double>& values, double p);
 // (observed: docs/notes/harness-measurement.md).
 Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference, std::span<const Ray> rays = {},
                        std::span<const Triangle> triangles = {});
+// The same for a scene with analytic primitives (issue 31): Hit::prim is a
+// global id of `prims`, and a tie involving an analytic primitive is the
+// referee's (referee/referee.h, same_t: both hit, t equal to within the
+// referee's enclosures of the exact t, a few double ulps).
+Agreement compare_hits(std::span<const Hit> tested, std::span<const Hit> reference, std::span<const Ray> rays,
+                       const PrimitiveSpans& prims);
 Agreement compare_occlusion(std::span<const std::uint8_t> tested, std::span<const std::uint8_t> reference);
 
 }  // namespace raybench

@@ -18,9 +18,14 @@
 #include <tbb/parallel_for.h>
 
 #include "io/error.h"
+#include "rays/analytic_targets.h"
 #include "scene/random.h"
 #include "raybench/bvh/bvh2_traverse.h"
 #include "raybench/math/offset_ray.h"
+#include "raybench/prim/aabb_slab.h"
+#include "raybench/prim/analytic_hit.h"
+#include "raybench/prim/obb_eigen.h"
+#include "raybench/prim/sphere_precise.h"
 
 namespace raybench {
 namespace {
@@ -122,9 +127,53 @@ RaySetKind parse_rayset_kind(const std::string& name) {
 Query query_of(RaySetKind kind) { return kind == RaySetKind::kShadow ? Query::kOccluded : Query::kIntersect; }
 
 RayGenerator::RayGenerator(const Scene& scene) : scene_(scene), bounds_(scene.bounds()) {
-  bvh_ = build_bvh2_binned_sah(scene.triangles);
-  prepared_.reserve(bvh_.prim_ids.size());
-  for (std::uint32_t id : bvh_.prim_ids) prepared_.push_back(MollerTrumbore::prepare(scene.triangles[id]));
+  if (!scene.has_analytic()) {
+    bvh_ = build_bvh2_binned_sah(scene.triangles);
+    prepared_.reserve(bvh_.prim_ids.size());
+    for (std::uint32_t id : bvh_.prim_ids) prepared_.push_back(MollerTrumbore::prepare(scene.triangles[id]));
+    return;
+  }
+  const PrimitiveSpans prims = scene.primitives();
+  std::vector<BBox> bounds(prims.size());
+  for (std::size_t id = 0; id < bounds.size(); ++id) bounds[id] = prims.bounds(id);
+  bvh_ = build_bvh2_binned_sah(std::span<const BBox>(bounds));
+  prepared_.resize(bvh_.prim_ids.size());
+  for (std::size_t i = 0; i < bvh_.prim_ids.size(); ++i)
+    if (bvh_.prim_ids[i] < scene.triangles.size()) prepared_[i] = MollerTrumbore::prepare(scene.triangles[bvh_.prim_ids[i]]);
+}
+
+Hit RayGenerator::closest_hit(const Ray& ray) const {
+  if (!scene_.has_analytic()) return intersect_bvh2<MollerTrumbore>(bvh_, prepared_, ray);
+  const PrimitiveSpans prims = scene_.primitives();
+  const Slab::Precomputed slab = Slab::precompute(ray);
+  Hit hit;
+  traverse_bvh2<false>(bvh_, ray, [&](std::uint32_t first, std::uint32_t count, float tmax) {
+    for (std::uint32_t i = first; i < first + count; ++i) {
+      const std::uint32_t id = bvh_.prim_ids[i];
+      const std::size_t local = prims.local(id);
+      float t = 0.0f;
+      bool found = false;
+      switch (prims.kind(id)) {
+        case PrimitiveKind::kTriangle: {
+          TriangleHit th;
+          if (MollerTrumbore::intersect(ray, tmax, prepared_[i], th)) {
+            tmax = th.t;
+            hit = {th.t, static_cast<std::int32_t>(id), th.u, th.v};
+          }
+          continue;
+        }
+        case PrimitiveKind::kSphere: found = intersect_sphere_surface<SpherePrecise>(ray, tmax, prims.spheres[local], t); break;
+        case PrimitiveKind::kBox: found = intersect_box_surface<Slab>(slab, ray, tmax, prims.boxes[local], t); break;
+        case PrimitiveKind::kOrientedBox: found = intersect_obb_surface<Obb>(ray, tmax, prims.obbs[local], t); break;
+      }
+      if (found) {
+        tmax = t;
+        hit = {t, static_cast<std::int32_t>(id), 0.0f, 0.0f};
+      }
+    }
+    return tmax;
+  });
+  return hit;
 }
 
 Camera RayGenerator::default_camera() const {
@@ -220,17 +269,30 @@ std::vector<Ray> RayGenerator::from_primary_hits(const RaySetSpec& spec, const C
       made[j] = 0;
       Rng rng(spec.seed, stream, first + j);
       const Ray primary = camera_ray(camera, rng.next_double(), rng.next_double());
-      const Hit hit = intersect_bvh2<MollerTrumbore>(bvh_, prepared_, primary);
+      const Hit hit = closest_hit(primary);
       if (!hit.hit()) return;
-      const Triangle& tri = scene_.triangles[hit.prim];
-      const Eigen::Vector3d v0 = to_eigen(tri.v0), v1 = to_eigen(tri.v1), v2 = to_eigen(tri.v2);
-      Eigen::Vector3d n = (v1 - v0).cross(v2 - v0);
-      if (!(n.norm() > 0.0)) return;  // zero-area triangle: no normal to bounce around
-      n.normalize();
+      Eigen::Vector3d n, p;
+      if (static_cast<std::size_t>(hit.prim) < scene_.triangles.size()) {
+        const Triangle& tri = scene_.triangles[hit.prim];
+        const Eigen::Vector3d v0 = to_eigen(tri.v0), v1 = to_eigen(tri.v1), v2 = to_eigen(tri.v2);
+        n = (v1 - v0).cross(v2 - v0);
+        if (!(n.norm() > 0.0)) return;  // zero-area triangle: no normal to bounce around
+        n.normalize();
+        // The hit point from barycentrics (more accurate than org + t dir).
+        p = (1.0 - hit.u - hit.v) * v0 + hit.u * v1 + hit.v * v2;
+      } else {
+        // An analytic hit: org + t dir moved onto the surface (t's rounding
+        // would otherwise leave it off by more than the offset below), and
+        // the outward normal there.
+        const Eigen::Vector3d org = to_eigen(primary.org), dir = to_eigen(primary.dir);
+        const SurfacePoint s =
+            nearest_surface_point(scene_.primitives(), static_cast<std::size_t>(hit.prim), org + static_cast<double>(hit.t) * dir, org, dir);
+        p = s.point;
+        n = s.normal;
+      }
+      // Offset off the surface on the side the primary ray came from (the
+      // inside, for a camera inside a sphere or box).
       if (n.dot(to_eigen(primary.dir)) > 0.0) n = -n;  // face the incoming ray
-      // The hit point from barycentrics (more accurate than org + t dir), then
-      // offset off the surface on the side the primary ray came from.
-      const Eigen::Vector3d p = (1.0 - hit.u - hit.v) * v0 + hit.u * v1 + hit.v * v2;
       Ray r;
       r.org = offset_ray_origin(to_vec(p), to_vec(n));
       // Reintersection (G18): odd rays toward a random point of the bounds,
@@ -291,14 +353,17 @@ std::vector<Ray> RayGenerator::uniform(const RaySetSpec& spec) const {
 // G01-G03 of ../shared/EXTREMES.md: origins uniform in the declared inside
 // ball; G01 uniform directions, G02 aimed at float lerp(a, b, s) on a random
 // edge of a random triangle, G03 at a random vertex. On a closed mesh every
-// one of these rays must hit.
+// one of these rays must hit. The random primitive may be analytic: G02 then
+// aims at a box's or OBB's edge (a sphere's surface point), G03 at a corner
+// (a sphere's axis-extreme point).
 std::vector<Ray> RayGenerator::must_hit(const RaySetSpec& spec) const {
   if (!spec.inside || !(spec.inside->radius > 0.0f))
     throw InputError(scene_.name, fmt::format("ray set '{}' needs a closed mesh with a ball inside it: declare "
                                               "inside = {{ center = [x, y, z], radius = r }} for the scene in the suite manifest",
                                               to_string(spec.kind)));
   std::vector<Ray> rays(spec.count);
-  const std::size_t triangles = scene_.triangles.size();
+  const PrimitiveSpans prims = scene_.primitives();
+  const std::size_t primitives = prims.size();  // the triangle count in a triangle scene, as before
   tbb::parallel_for(std::size_t{0}, spec.count, [&](std::size_t i) {
     Rng rng(spec.seed, stream_of(spec.kind), i);
     // Uniform in the ball: a uniform direction times radius * cbrt(u).
@@ -308,8 +373,11 @@ std::vector<Ray> RayGenerator::must_hit(const RaySetSpec& spec) const {
     r.org = to_vec(origin);
     if (spec.kind == RaySetKind::kClosedInsideRandom) {
       r.dir = to_vec(uniform_direction(rng));
+    } else if (const std::size_t id = rng.next_u64() % primitives; id >= prims.triangles.size()) {
+      const Vec3f target = spec.kind == RaySetKind::kSharedEdgeAimed ? random_edge_point(prims, id, rng) : random_corner(prims, id, rng);
+      r.dir = target - r.org;
     } else {
-      const Triangle& t = scene_.triangles[rng.next_u64() % triangles];
+      const Triangle& t = scene_.triangles[id];
       const Vec3f corners[3] = {t.v0, t.v1, t.v2};
       const auto corner = rng.next_u64() % 3;
       Vec3f target = corners[corner];
@@ -364,13 +432,117 @@ Ray invalidate(Ray r, std::size_t i) {
   return r;
 }
 
+// G09's ray at `target`: direction pattern i % 26 of {-1, 0, +1}^3 minus the
+// zero vector, each zero +0 or -0. The origin shares the target's
+// coordinates along the zero components, so it lies exactly on the slab
+// planes through the target (a vertex or corner: a corner of every box
+// holding it; or a point of the surface).
+Ray axis_parallel_ray(std::size_t i, Vec3f t, double radius, Rng& rng) {
+  const std::size_t k = i % 26, code = k < 13 ? k : k + 1;
+  const int c[3] = {static_cast<int>(code % 3) - 1, static_cast<int>(code / 3 % 3) - 1, static_cast<int>(code / 9) - 1};
+  float d[3], o[3];
+  const float tc[3] = {t.x, t.y, t.z};
+  const double distance = radius * (0.5 + rng.next_double());
+  for (int a = 0; a < 3; ++a) {
+    const bool negative_zero = rng.next_u64() % 2;
+    d[a] = c[a] == 0 ? (negative_zero ? -0.0f : 0.0f) : static_cast<float>(c[a]);
+    o[a] = c[a] == 0 ? tc[a] : static_cast<float>(tc[a] - distance * c[a]);
+  }
+  Ray r;
+  r.org = {o[0], o[1], o[2]};
+  r.dir = {d[0], d[1], d[2]};
+  return r;
+}
+
+// The extreme ray sets that aim at a triangle, aimed at analytic primitive
+// `id` instead (issue 31). `center`, `radius`: the scene's bounding sphere.
+Ray analytic_extreme_ray(RaySetKind kind, std::size_t i, const PrimitiveSpans& prims, std::size_t id, Rng& rng,
+                         const Eigen::Vector3d& center, double radius) {
+  const double size = std::max(primitive_size(prims, id), 1e-30);
+  Ray r;
+  switch (kind) {
+    case RaySetKind::kTinyTriangles:
+    case RaySetKind::kDegenerateTriangles: {
+      // A surface point (10 % from a face's edges), from outside its tangent
+      // plane, 1 to 10 sizes away (plus one unit for odd rays): the first
+      // surface the ray meets on this primitive is at that point.
+      const SurfacePoint s = random_surface_point(prims, id, rng, 0.1);
+      Eigen::Vector3d w = uniform_direction(rng);
+      if (w.dot(s.normal) < 0.0) w = -w;
+      const double distance = size * (1.0 + 9.0 * rng.next_double()) + (i % 2 ? 1.0 : 0.0);
+      r.org = to_vec(s.point + distance * w);
+      r.dir = to_vec(s.point) - r.org;
+      break;
+    }
+    case RaySetKind::kGrazing: {
+      // At 1e-2 ... 1e-6 rad to the surface where the ray meets it: a
+      // sphere's ray passes its centre at r cos(alpha) (alpha to the tangent
+      // plane where it enters: near-tangent, rounding decides below ~3e-4); a
+      // box's or OBB's ray reaches a face point at alpha to the face, from
+      // outside or from inside at random, as for a triangle's two sides.
+      const double alpha = std::pow(10.0, -2.0 - static_cast<double>(i % 5));
+      const double phi = 2.0 * std::numbers::pi * rng.next_double();
+      Eigen::Vector3d b1, b2;
+      if (prims.kind(id) == PrimitiveKind::kSphere) {
+        const Sphere& sphere = prims.spheres[prims.local(id)];
+        const Eigen::Vector3d u = uniform_direction(rng);
+        basis(u, b1, b2);
+        const Eigen::Vector3d d = std::cos(phi) * b1 + std::sin(phi) * b2;
+        const Eigen::Vector3d closest = to_eigen(sphere.center) + std::fabs(static_cast<double>(sphere.radius)) * std::cos(alpha) * u;
+        r.org = to_vec(closest - 2.0 * size * d);
+        r.dir = to_vec(d);
+      } else {
+        const SurfacePoint s = random_surface_point(prims, id, rng, 0.1);
+        basis(s.normal, b1, b2);
+        const Eigen::Vector3d d = std::cos(alpha) * (std::cos(phi) * b1 + std::sin(phi) * b2) +
+                                  std::sin(alpha) * (rng.next_u64() % 2 ? s.normal : Eigen::Vector3d(-s.normal));
+        r.org = to_vec(s.point - 2.0 * size * d);
+        r.dir = to_vec(d);
+      }
+      break;
+    }
+    case RaySetKind::kAxisParallel: {
+      const Vec3f target = i % 3 == 0 ? random_corner(prims, id, rng) : to_vec(random_surface_point(prims, id, rng, 0.0).point);
+      r = axis_parallel_ray(i, target, radius, rng);
+      break;
+    }
+    case RaySetKind::kBehindOrigin: {
+      // Away from a surface point, out of its tangent plane: the convex
+      // primitive lies wholly behind the origin (at t < 0).
+      const SurfacePoint s = random_surface_point(prims, id, rng, 0.1);
+      Eigen::Vector3d away = uniform_direction(rng);
+      if (away.dot(s.normal) < 0.0) away = -away;
+      r.org = to_vec(s.point + size * (1.0 + rng.next_double()) * away);
+      r.dir = to_vec(away);
+      break;
+    }
+    case RaySetKind::kBvhConservative: {
+      // Corners (a sphere's axis-extreme points, where it touches its
+      // bounding box) and float points of edges, from outside the scene.
+      const Vec3f target = i % 2 ? random_edge_point(prims, id, rng) : random_corner(prims, id, rng);
+      r.org = to_vec(center + 1.5 * radius * uniform_direction(rng));
+      r.dir = target - r.org;
+      break;
+    }
+    default: break;
+  }
+  return r;
+}
+
+// Whether an extreme kind aims at a random primitive (the others use only the scene's bounds).
+bool aims_at_primitive(RaySetKind kind) {
+  return kind == RaySetKind::kTinyTriangles || kind == RaySetKind::kDegenerateTriangles || kind == RaySetKind::kGrazing ||
+         kind == RaySetKind::kAxisParallel || kind == RaySetKind::kBehindOrigin || kind == RaySetKind::kBvhConservative;
+}
+
 }  // namespace
 
 // The extreme ray sets of ../shared/EXTREMES.md that work on any scene. Each
 // ray depends only on (seed, kind, index), like every other ray set.
 std::vector<Ray> RayGenerator::extreme(const RaySetSpec& spec) const {
   std::vector<Ray> rays(spec.count);
-  const std::size_t triangles = scene_.triangles.size();
+  const PrimitiveSpans prims = scene_.primitives();
+  const std::size_t primitives = prims.size();  // the triangle count in a triangle scene, as before
   const Eigen::Vector3d lower = to_eigen(bounds_.lower), extent = to_eigen(bounds_.extent());
   const Eigen::Vector3d center = to_eigen(bounds_.center());
   const double radius = std::max(0.5 * extent.norm(), 1e-30);
@@ -380,7 +552,14 @@ std::vector<Ray> RayGenerator::extreme(const RaySetSpec& spec) const {
   const auto outside_origin = [&](Rng& rng) { return Eigen::Vector3d(center + 1.5 * radius * uniform_direction(rng)); };
   tbb::parallel_for(std::size_t{0}, spec.count, [&](std::size_t i) {
     Rng rng(spec.seed, stream_of(spec.kind), i);
-    const Triangle& tri = scene_.triangles[rng.next_u64() % triangles];
+    const std::size_t id = rng.next_u64() % primitives;
+    const bool analytic = id >= prims.triangles.size();
+    if (analytic && aims_at_primitive(spec.kind)) {
+      rays[i] = analytic_extreme_ray(spec.kind, i, prims, id, rng, center, radius);
+      return;
+    }
+    static const Triangle kUnused{};  // the kinds below that read `tri` were handled above for analytic ids
+    const Triangle& tri = analytic ? kUnused : scene_.triangles[id];
     Ray r;
     switch (spec.kind) {
       case RaySetKind::kTinyTriangles:
@@ -410,24 +589,8 @@ std::vector<Ray> RayGenerator::extreme(const RaySetSpec& spec) const {
         break;
       }
       case RaySetKind::kAxisParallel: {
-        // Direction pattern k of {-1, 0, +1}^3 minus the zero vector, each zero
-        // +0 or -0. The origin shares the target's coordinates along the zero
-        // components, so it lies exactly on the slab planes through the target
-        // (a vertex, i.e. a corner of every box holding it, or a point of the triangle).
-        const std::size_t k = i % 26, code = k < 13 ? k : k + 1;
-        const int c[3] = {static_cast<int>(code % 3) - 1, static_cast<int>(code / 3 % 3) - 1, static_cast<int>(code / 9) - 1};
         const Eigen::Vector3d target = i % 3 == 0 ? to_eigen(tri.v0) : interior_point(tri, rng, 0.0);
-        const Vec3f t = to_vec(target);
-        float d[3], o[3];
-        const float tc[3] = {t.x, t.y, t.z};
-        const double distance = radius * (0.5 + rng.next_double());
-        for (int a = 0; a < 3; ++a) {
-          const bool negative_zero = rng.next_u64() % 2;
-          d[a] = c[a] == 0 ? (negative_zero ? -0.0f : 0.0f) : static_cast<float>(c[a]);
-          o[a] = c[a] == 0 ? tc[a] : static_cast<float>(tc[a] - distance * c[a]);
-        }
-        r.org = {o[0], o[1], o[2]};
-        r.dir = {d[0], d[1], d[2]};
+        r = axis_parallel_ray(i, to_vec(target), radius, rng);
         break;
       }
       case RaySetKind::kBehindOrigin: {

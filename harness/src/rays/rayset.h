@@ -50,7 +50,7 @@ Query query_of(RaySetKind kind);
 // True for the must-hit kinds (G01-G03): they need RaySetSpec::inside.
 bool is_must_hit(RaySetKind kind);
 // True for rays that start on a surface (diffuse, shadow, reintersection):
-// they have a source triangle, and hitting it again is a self-intersection.
+// they have a source primitive, and hitting it again is a self-intersection.
 bool has_sources(RaySetKind kind);
 
 // A pinhole camera; y is up unless `up` says otherwise.
@@ -80,15 +80,23 @@ struct RaySetSpec {
 inline constexpr int kRayGeneratorVersion = 3;
 
 // Makes ray sets for one scene. Diffuse and shadow rays start at primary
-// hits, found with our BVH2 (built once here).
+// hits, found with our BVH2 (built once here): over the triangles with
+// Möller-Trumbore for a triangle scene; over every primitive's box for a scene
+// with analytic primitives (issue 31), whose leaves test triangles as before
+// and spheres, boxes and OBBs as surfaces (prim/analytic_hit.h: SpherePrecise,
+// Slab, Obb). The sets that aim at triangles aim at every primitive: a
+// random primitive id over all of them, and for an analytic one a point of
+// its surface, a corner, an edge or a tangent (rays/analytic_targets.h). A
+// scene without analytic primitives gets exactly the rays it always got.
 class RayGenerator {
  public:
   explicit RayGenerator(const Scene& scene);
 
   // Throws InputError when the camera sees (almost) nothing of the scene, so
   // that diffuse or shadow rays cannot be made.
-  // `sources`, when given, receives for every ray the triangle it starts
-  // from (secondary rays: diffuse, shadow, reintersection), or kNoHit.
+  // `sources`, when given, receives for every ray the primitive (global id,
+  // raybench/prim/primitives.h) it starts from (secondary rays: diffuse,
+  // shadow, reintersection), or kNoHit.
   std::vector<Ray> generate(const RaySetSpec& spec, std::vector<std::int32_t>* sources = nullptr) const;
 
   Camera default_camera() const;
@@ -102,11 +110,13 @@ class RayGenerator {
   std::vector<Ray> uniform(const RaySetSpec& spec) const;
   std::vector<Ray> must_hit(const RaySetSpec& spec) const;
   std::vector<Ray> extreme(const RaySetSpec& spec) const;
+  // The primary hit: MT over triangles, or every type over all primitives.
+  Hit closest_hit(const Ray& ray) const;
 
   const Scene& scene_;
   BBox bounds_;
-  Bvh2 bvh_;
-  std::vector<MollerTrumbore::Prepared> prepared_;
+  Bvh2 bvh_;  // over the triangles, or over every primitive's box when the scene has analytic ones
+  std::vector<MollerTrumbore::Prepared> prepared_;  // in leaf order (unused entries for analytic primitives)
 };
 
 }  // namespace raybench

@@ -125,6 +125,27 @@ ExactPrimitiveHit decide(const SlabRange& range, const RayInterval& iv) {
   return out;
 }
 
+// A boundary occupying the ends of [E, X] along the ray, against the
+// interval (lo, tfar]: the first of E, X inside it (exact_intersect_surface).
+ExactPrimitiveHit decide_surface(const SlabRange& range, const RayInterval& iv) {
+  ExactPrimitiveHit out;
+  if (range.empty || iv.empty) return out;
+  const bool open_interval_nonempty = !iv.hi || *iv.hi > iv.lo;
+  const auto inside = [&](const std::optional<Rational>& t) {
+    return open_interval_nonempty && t && *t > iv.lo && (!iv.hi || *t <= *iv.hi);
+  };
+  out.start_contact = (range.entry && *range.entry == iv.lo) || (range.exit && *range.exit == iv.lo);
+  if (inside(range.entry)) {
+    out.hit = true;
+    out.t = nearest_double(*range.entry);
+  } else if (inside(range.exit)) {
+    out.hit = true;
+    out.exit = true;
+    out.t = nearest_double(*range.exit);
+  }
+  return out;
+}
+
 // sign(w + s sqrt(D)) for s = +1 or -1, D >= 0, without a square root.
 int sign_with_root(const Rational& w, const Rational& D, int s) {
   const int sw = CGAL::sign(w);
@@ -166,24 +187,27 @@ bool is_exact_ray(const Ray& ray) {
          !(ray.dir.x == 0.0f && ray.dir.y == 0.0f && ray.dir.z == 0.0f);
 }
 
-ExactPrimitiveHit exact_intersect(const Ray& ray, const BBox& box) {
+namespace {
+
+// The box's [E, X] along the ray; none for the empty box or an exact-invalid ray.
+std::optional<SlabRange> slab_range(const Ray& ray, const BBox& box) {
   for (int i = 0; i < 3; ++i) require_finite(!std::isnan(box.lower[i]) && !std::isnan(box.upper[i]), "box (NaN)");
   for (int i = 0; i < 3; ++i)
-    if (box.lower[i] > box.upper[i]) return {};  // the empty box
+    if (box.lower[i] > box.upper[i]) return std::nullopt;  // the empty box
   require_finite(is_finite(box.lower) && is_finite(box.upper), "box");
-  if (!is_exact_ray(ray)) return {};
+  if (!is_exact_ray(ray)) return std::nullopt;
   SlabRange range;
   for (int i = 0; i < 3; ++i) range.clip(exact(ray.org[i]), exact(ray.dir[i]), exact(box.lower[i]), exact(box.upper[i]));
-  return decide(range, ray_interval(ray));
+  return range;
 }
 
-ExactPrimitiveHit exact_intersect(const Ray& ray, const OrientedBox& box) {
+std::optional<SlabRange> slab_range(const Ray& ray, const OrientedBox& box) {
   require_finite(is_finite(box.center) && is_finite(box.axis[0]) && is_finite(box.axis[1]) && is_finite(box.axis[2]) &&
                      is_finite(box.half_extent),
                  "oriented box");
-  if (!is_exact_ray(ray)) return {};
+  if (!is_exact_ray(ray)) return std::nullopt;
   for (int i = 0; i < 3; ++i)
-    if (box.half_extent[i] < 0.0f) return {};  // an empty box
+    if (box.half_extent[i] < 0.0f) return std::nullopt;  // an empty box
   const Vec3q offset = exact(ray.org) - exact(box.center), dir = exact(ray.dir);
   SlabRange range;
   for (int i = 0; i < 3; ++i) {
@@ -191,10 +215,36 @@ ExactPrimitiveHit exact_intersect(const Ray& ray, const OrientedBox& box) {
     const Rational h = exact(box.half_extent[i]);
     range.clip(dot(offset, axis), dot(dir, axis), -h, h);
   }
-  return decide(range, ray_interval(ray));
+  return range;
 }
 
-ExactPrimitiveHit exact_intersect(const Ray& ray, const Sphere& sphere) {
+}  // namespace
+
+ExactPrimitiveHit exact_intersect(const Ray& ray, const BBox& box) {
+  const std::optional<SlabRange> range = slab_range(ray, box);
+  return range ? decide(*range, ray_interval(ray)) : ExactPrimitiveHit{};
+}
+
+ExactPrimitiveHit exact_intersect(const Ray& ray, const OrientedBox& box) {
+  const std::optional<SlabRange> range = slab_range(ray, box);
+  return range ? decide(*range, ray_interval(ray)) : ExactPrimitiveHit{};
+}
+
+ExactPrimitiveHit exact_intersect_surface(const Ray& ray, const BBox& box) {
+  const std::optional<SlabRange> range = slab_range(ray, box);
+  return range ? decide_surface(*range, ray_interval(ray)) : ExactPrimitiveHit{};
+}
+
+ExactPrimitiveHit exact_intersect_surface(const Ray& ray, const OrientedBox& box) {
+  const std::optional<SlabRange> range = slab_range(ray, box);
+  return range ? decide_surface(*range, ray_interval(ray)) : ExactPrimitiveHit{};
+}
+
+namespace {
+
+// Both sphere referees; `contact_on_hits`: set start_contact for hits as
+// well (exact_intersect_surface's meaning of it).
+ExactPrimitiveHit sphere_hit(const Ray& ray, const Sphere& sphere, bool contact_on_hits) {
   require_finite(is_finite(sphere.center) && std::isfinite(sphere.radius), "sphere");
   ExactPrimitiveHit out;
   if (!is_exact_ray(ray)) return out;
@@ -209,14 +259,22 @@ ExactPrimitiveHit exact_intersect(const Ray& ray, const Sphere& sphere) {
   const auto compare_root = [&](int s, const Rational& v) { return sign_with_root(-b - a * v, D, s); };
   const auto in_interval = [&](int s) { return compare_root(s, iv.lo) > 0 && (!iv.hi || compare_root(s, *iv.hi) <= 0); };
   const bool in0 = in_interval(-1), in1 = in_interval(+1);
+  const auto contact = [&] { return compare_root(-1, iv.lo) == 0 || compare_root(+1, iv.lo) == 0; };
   if (!in0 && !in1) {
-    out.start_contact = compare_root(-1, iv.lo) == 0 || compare_root(+1, iv.lo) == 0;
+    out.start_contact = contact();
     return out;
   }
   out.hit = true;
   out.exit = !in0;
   out.t = sphere_root(a, b, C, D, in0 ? -1 : +1);
+  if (contact_on_hits) out.start_contact = contact();
   return out;
 }
+
+}  // namespace
+
+ExactPrimitiveHit exact_intersect(const Ray& ray, const Sphere& sphere) { return sphere_hit(ray, sphere, false); }
+
+ExactPrimitiveHit exact_intersect_surface(const Ray& ray, const Sphere& sphere) { return sphere_hit(ray, sphere, true); }
 
 }  // namespace raybench

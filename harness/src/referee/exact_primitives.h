@@ -91,4 +91,20 @@ ExactPrimitiveHit exact_intersect(const Ray& ray, const BBox& box);
 ExactPrimitiveHit exact_intersect(const Ray& ray, const OrientedBox& box);
 ExactPrimitiveHit exact_intersect(const Ray& ray, const Sphere& sphere);
 
+// The same primitives as the surfaces of a scene (issue 31,
+// prim/analytic_hit.h): the ray hits at the first crossing of the boundary
+// in (lo, tfar]. For a box or OBB the solid occupies [E, X] along the ray:
+// t = E when E lies in (lo, tfar]; otherwise t = X (`exit`) when X does;
+// otherwise a miss. It differs from exact_intersect's solid answer only for
+// a ray that starts inside and ends inside (X > tfar): no crossing, a miss.
+// A sphere's answer is exact_intersect's (already a surface).
+// `start_contact` here means the surface contains the point at t = lo
+// exactly, for hits too: the origin lies on the surface (E = lo, pointing in:
+// the hit is the exit; X = lo, pointing out: a miss). A float test sees such
+// an origin on either side of the surface, so the referee counts the ray as
+// ambiguous.
+ExactPrimitiveHit exact_intersect_surface(const Ray& ray, const BBox& box);
+ExactPrimitiveHit exact_intersect_surface(const Ray& ray, const OrientedBox& box);
+ExactPrimitiveHit exact_intersect_surface(const Ray& ray, const Sphere& sphere);
+
 }  // namespace raybench

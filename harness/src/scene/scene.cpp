@@ -1,6 +1,6 @@
 // Scene helpers (scene/scene.h): its bounds, and the coordinate check that
 // refuses a vertex that is not finite or beyond kMaxSceneCoordinate, naming
-// the triangle.
+// the triangle, and an analytic primitive whose box is, naming it.
 #include "scene/scene.h"
 
 #include <cmath>
@@ -18,6 +18,17 @@ BBox Scene::bounds() const {
   return b;
 }
 
+std::string describe_primitives(const Scene& scene) {
+  const auto count = [](std::size_t n, const char* one, const char* many) {
+    return std::to_string(n) + " " + (n == 1 ? one : many);
+  };
+  std::string out = count(scene.triangles.size(), "triangle", "triangles");
+  if (!scene.spheres.empty()) out += ", " + count(scene.spheres.size(), "sphere", "spheres");
+  if (!scene.boxes.empty()) out += ", " + count(scene.boxes.size(), "box", "boxes");
+  if (!scene.obbs.empty()) out += ", " + count(scene.obbs.size(), "oriented box", "oriented boxes");
+  return out;
+}
+
 void check_scene_coordinates(const Scene& scene, const std::string& where) {
   for (std::size_t i = 0; i < scene.triangles.size(); ++i) {
     const Triangle& t = scene.triangles[i];
@@ -30,6 +41,21 @@ void check_scene_coordinates(const Scene& scene, const std::string& where) {
                                     (std::isfinite(c) ? "of " : "that is not finite: ") + value +
                                     "; coordinates must be finite and within +-1e18 (box areas must stay finite in float)");
       }
+    }
+  }
+  // An analytic primitive's box (primitives.h) holds all of it: a sphere's
+  // centre +- radius, an oriented box's reach; NaN fails the comparison.
+  const PrimitiveSpans all = scene.primitives();
+  for (std::size_t id = all.first_sphere(); id < all.size(); ++id) {
+    const BBox b = all.bounds(id);
+    for (const float c : {b.lower.x, b.lower.y, b.lower.z, b.upper.x, b.upper.y, b.upper.z}) {
+      if (std::fabs(c) <= kMaxSceneCoordinate) continue;
+      char value[32];
+      std::snprintf(value, sizeof value, "%g", static_cast<double>(c));
+      throw InputError(where, std::string(to_string(all.kind(id))) + " " + std::to_string(all.local(id)) +
+                                  " (prim " + std::to_string(id) + ") reaches a coordinate " +
+                                  (std::isfinite(c) ? "of " : "that is not finite: ") + value +
+                                  "; coordinates must be finite and within +-1e18 (box areas must stay finite in float)");
     }
   }
 }

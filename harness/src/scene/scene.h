@@ -44,6 +44,11 @@ struct Scene {
   std::uint64_t content_hash() const;
 };
 
+// "7808 triangles", or with analytic primitives "2 triangles, 120 spheres,
+// 3 boxes, 1 oriented box" (the types it has, in prim-id order): what
+// progress lines and `raybench scenes` say a scene holds.
+std::string describe_primitives(const Scene& scene);
+
 // Loads a mesh file with assimp, or builds a procedural scene when `spec`
 // starts with "proc:" (see procedural.h). Throws InputError naming the file
 // on a missing, unreadable or malformed file, one without triangles, or one
@@ -61,7 +66,8 @@ Scene load_scene(const std::string& spec);
 inline constexpr float kMaxSceneCoordinate = 1e18f;
 
 // Throws InputError(where, ...) when a vertex of `scene` is not finite or
-// has a coordinate beyond +-kMaxSceneCoordinate; `where` names the file or
+// has a coordinate beyond +-kMaxSceneCoordinate, or an analytic primitive's
+// box (raybench/prim/primitives.h) does; `where` names the file or
 // the manifest's scene. load_scene runs it on what the file holds, and
 // load_suite_scene (suite.h) again after the manifest's scale and offset,
 // on the vertices as they will be traced.

@@ -13,6 +13,7 @@
 #include "backends/backend.h"
 #include "io/error.h"
 #include "io/input_file.h"
+#include "scene/analytic_files.h"
 #include "scene/procedural.h"
 #include "suite/settings_rules.h"
 
@@ -222,23 +223,61 @@ void move_entry(SuiteScene& scene) {
 }  // namespace
 
 Scene load_suite_scene(const SuiteScene& entry) {
-  Scene scene = load_scene(entry.path);
+  Scene scene;
+  if (!entry.path.empty()) scene = load_scene(entry.path);
+  if (!entry.spheres.empty()) scene.spheres = read_sphere_file(entry.spheres);
+  if (!entry.boxes.empty()) scene.boxes = read_box_file(entry.boxes);
+  if (!entry.obbs.empty()) scene.obbs = read_obb_file(entry.obbs);
   scene.name = entry.name;
+  scene.source = entry.sources();
+  // A mesh without triangles is refused by load_scene; files of 0 rows are
+  // valid arrays, but a scene of nothing has nothing to trace.
+  if (scene.primitive_count() == 0)
+    throw InputError("scene '" + entry.name + "' (" + entry.sources() + ")",
+                     "holds no primitives (its files have 0 rows): nothing to trace");
   if (entry.transformed()) {
     for (Triangle& t : scene.triangles) {
       t.v0 = moved(t.v0, entry.scale, entry.offset);
       t.v1 = moved(t.v1, entry.scale, entry.offset);
       t.v2 = moved(t.v2, entry.scale, entry.offset);
     }
-    check_scene_coordinates(scene, "scene '" + entry.name + "' (" + entry.path + " with the manifest's scale and offset)");
+    const double s = entry.scale;
+    for (Sphere& b : scene.spheres) {
+      b.center = moved(b.center, s, entry.offset);
+      b.radius = static_cast<float>(s * b.radius);
+    }
+    // scale > 0 and rounding is monotonic: lower <= upper stays true.
+    for (BBox& b : scene.boxes) {
+      b.lower = moved(b.lower, s, entry.offset);
+      b.upper = moved(b.upper, s, entry.offset);
+    }
+    for (OrientedBox& o : scene.obbs) {
+      o.center = moved(o.center, s, entry.offset);
+      o.half_extent = {static_cast<float>(s * o.half_extent.x), static_cast<float>(s * o.half_extent.y),
+                       static_cast<float>(s * o.half_extent.z)};
+    }
+    check_scene_coordinates(scene, "scene '" + entry.name + "' (" + entry.sources() +
+                                       " with the manifest's scale and offset)");
   }
   return scene;
 }
 
-bool SuiteScene::available() const {
-  if (path.rfind(kProceduralPrefix, 0) == 0) return true;
-  std::error_code ec;
-  return std::filesystem::is_regular_file(path, ec);
+std::string SuiteScene::missing() const {
+  for (const std::string* file : {&path, &spheres, &boxes, &obbs}) {
+    if (file->empty() || file->rfind(kProceduralPrefix, 0) == 0) continue;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(*file, ec)) return *file;
+  }
+  return "";
+}
+
+bool SuiteScene::available() const { return missing().empty(); }
+
+std::string SuiteScene::sources() const {
+  std::string out = path;
+  for (const auto& [key, file] : {std::pair{"spheres", &spheres}, {"boxes", &boxes}, {"obbs", &obbs}})
+    if (!file->empty()) out += fmt::format("{}{} {}", out.empty() ? "" : " + ", key, *file);
+  return out;
 }
 
 const SuiteScene* Suite::find(const std::string& name) const {
@@ -309,16 +348,30 @@ Suite load_suite(const std::string& path) {
       const std::string key = fmt::format("scene[{}]", index++);
       const toml::table* t = e.as_table();
       if (!t) r.fail(key, "expected a table");
-      r.check_keys(*t, key, {"name", "path", "optional", "camera", "light", "inside", "raysets", "note", "scale", "offset", "sweep",
-                           "tessellate"});
+      r.check_keys(*t, key, {"name", "path", "spheres", "boxes", "obbs", "optional", "camera", "light", "inside",
+                             "raysets", "note", "scale", "offset", "sweep",
+                             "tessellate"});
       SuiteScene scene;
       scene.name = r.get<std::string>(*t, key + ".", "name", "");
       scene.path = r.get<std::string>(*t, key + ".", "path", "");
-      if (scene.name.empty() || scene.path.empty()) r.fail(key, "needs a name and a path");
+      scene.spheres = r.get<std::string>(*t, key + ".", "spheres", "");
+      scene.boxes = r.get<std::string>(*t, key + ".", "boxes", "");
+      scene.obbs = r.get<std::string>(*t, key + ".", "obbs", "");
+      for (const char* k : {"path", "spheres", "boxes", "obbs"})
+        if (t->get(k) && r.get<std::string>(*t, key + ".", k, "").empty()) r.fail(key + "." + k, "is empty");
+      if (scene.name.empty() || (scene.path.empty() && scene.spheres.empty() && scene.boxes.empty() && scene.obbs.empty()))
+        r.fail(key, "needs a name and a path (a mesh or proc:<name>), or analytic primitives (spheres, boxes, obbs "
+                    "= \"FILE.npy\"), or both");
       if (const std::string problem = scene_name_problem(scene.name); !problem.empty()) r.fail(key + ".name", problem);
       if (suite.find(scene.name) && !t->get("sweep")) r.fail(key + ".name", "duplicate scene name '" + scene.name + "'");
-      if (scene.path.rfind(kProceduralPrefix, 0) != 0 && fs::path(scene.path).is_relative())
+      if (!scene.path.empty() && scene.path.rfind(kProceduralPrefix, 0) != 0 && fs::path(scene.path).is_relative())
         scene.path = (base / scene.path).lexically_normal().string();
+      for (const auto& [k, file] : {std::pair{"spheres", &scene.spheres}, {"boxes", &scene.boxes}, {"obbs", &scene.obbs}}) {
+        if (file->rfind(kProceduralPrefix, 0) == 0)
+          r.fail(key + "." + k, fmt::format("'{}' is a procedural scene's name; {} names a .npy file (a procedural "
+                                            "scene goes in path)", *file, k));
+        if (!file->empty() && fs::path(*file).is_relative()) *file = (base / *file).lexically_normal().string();
+      }
       scene.optional = r.get<bool>(*t, key + ".", "optional", false);
       if (const toml::node* c = t->get("camera")) scene.camera = r.camera(*c, key + ".camera");
       if (const toml::node* l = t->get("light")) scene.light = r.point(*l, key + ".light");

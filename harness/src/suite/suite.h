@@ -15,7 +15,13 @@ namespace raybench {
 
 struct SuiteScene {
   std::string name;  // used in results and on the command line
-  std::string path;  // resolved against the manifest's folder; or "proc:<name>"
+  std::string path;  // resolved against the manifest's folder; or "proc:<name>"; or empty
+  // Analytic primitives (issue 31, scene/analytic_files.h): .npy files
+  // resolved as `path` is, empty when not given. A scene has a path, some of
+  // these, or both; their primitives follow the path's triangles in prim ids.
+  std::string spheres;
+  std::string boxes;
+  std::string obbs;
   bool optional = false;  // skipped with a note when the file is absent
   std::optional<Camera> camera;
   std::optional<Vec3f> light;
@@ -24,16 +30,26 @@ struct SuiteScene {
   // This scene's tessellation study (scene/tessellate.h): the resolutions of
   // its triangle stand-ins; unset: the suite's defaults; empty: none.
   std::optional<std::vector<Tessellation>> tessellate;
-  // Every vertex v becomes float(scale * v + offset) after loading; camera,
-  // light and inside ball (given for the untransformed scene) move with it.
+  // Every vertex v becomes float(scale * v + offset) after loading, as do
+  // sphere and box centres and box corners; radii and half extents become
+  // float(scale * r); OBB axes are kept. Camera, light and inside ball
+  // (given for the untransformed scene) move with it.
   double scale = 1.0;
   std::array<double, 3> offset{0.0, 0.0, 0.0};
 
-  bool available() const;
+  bool available() const;  // every file it names exists (a proc: path always does)
+  std::string missing() const;  // the first file it names that is absent, or ""
+  // What it is made of, for listings and messages: the path and each
+  // primitive file, e.g. "m.obj + spheres b.npy".
+  std::string sources() const;
   bool transformed() const { return scale != 1.0 || offset != std::array<double, 3>{0.0, 0.0, 0.0}; }
 };
 
-// Loads the scene an entry names, transformed and named as the entry says.
+// Loads the scene an entry names (its mesh or procedural scene, then its
+// primitive files), transformed and named as the entry says. Throws
+// InputError naming the file at fault (analytic_files.h), or the scene when
+// it holds no primitive at all or the transform takes one beyond
+// kMaxSceneCoordinate.
 Scene load_suite_scene(const SuiteScene& entry);
 
 struct SuiteSettings {

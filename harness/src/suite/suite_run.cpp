@@ -89,6 +89,7 @@ struct SceneResults {
   std::vector<ResultRow> rows;
   std::vector<AccuracyRow> accuracy;  // runs with RunOptions::accuracy_csv only
   std::optional<CameraCoverage> camera;  // runs with the primary ray set
+  std::vector<SkippedBackend> skipped;
 };
 
 // The seed of a scene's round orders: the run's seed and the scene's name,
@@ -166,6 +167,12 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
       stand_in ? stand_in->tessellation.name() : scene.has_analytic() ? "analytic" : "triangles";
   SceneResults results;
 
+  // Backends lacking a primitive type of the scene are skipped for it, with
+  // a note: never given a scene they would trace wrongly (a plugin would see
+  // only its triangles).
+  const std::vector<std::string> runnable = backends_for_scene(settings.backends, scene, results.skipped);
+  for (const SkippedBackend& s : results.skipped) progress(fmt::format("  {}: skipped, {}", s.backend, s.reason));
+
   struct Case {
     std::string name;
     ResultRow row;
@@ -182,6 +189,8 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
     const TraceExecutor& executor = *executors.back();
     // Embree's answers, per ray set, for agreement.
     std::unique_ptr<Backend> baseline = make_backend(kAgreementBackend, {threads});
+    if (const std::string problem = capability_problem(*baseline, scene); !problem.empty())
+      throw std::logic_error("the agreement baseline must model every scene: " + problem);
     executor.run([&] { baseline->build(scene); });
     std::vector<std::vector<Hit>> ref_hits(raysets.size());
     std::vector<std::vector<std::uint8_t>> ref_occ(raysets.size());
@@ -202,14 +211,14 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
     }
 
     std::vector<Backend*> built;
-    for (const std::string& backend_name : settings.backends) {
+    for (const std::string& backend_name : runnable) {
       backends.push_back(make_backend(backend_name, {threads}));
       built.push_back(backends.back().get());
     }
     const std::vector<std::vector<double>> build_times =
         time_builds_interleaved(built, scene, executor, settings.build_repetitions, settings.min_time);
     for (std::size_t bi = 0; bi < built.size(); ++bi) {
-      const std::string& backend_name = settings.backends[bi];
+      const std::string& backend_name = runnable[bi];
       const Backend* backend = built[bi];
       const std::vector<double>& build_ms = build_times[bi];
       progress(fmt::format("  built {} ({} threads) in {:.1f} ms, {:.1f} MiB", backend_name, threads, median(build_ms),
@@ -253,8 +262,8 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
         // the referee judges them against the rays as stored.
         if (query_of(rs.kind) == Query::kIntersect) {
           const std::vector<Hit> hits = executor.answers(*backend, rs.screened);
-          require_valid_hits(*backend, hits, scene.triangles.size(), scene.name + "/" + row.rayset);
-          a = compare_hits(hits, ref_hits[r], rs.screened.rays, scene.triangles);
+          require_valid_hits(*backend, hits, scene.primitive_count(), scene.name + "/" + row.rayset);
+          a = compare_hits(hits, ref_hits[r], rs.screened.rays, scene.primitives());
           if (accuracy)
             judge_hits(*referee, rs.rays, rs.truth, stand_in ? analytic_hits(hits, *stand_in) : hits, rs.sources,
                        *accuracy);
@@ -425,6 +434,21 @@ std::size_t write_finished_scenes(const RunOptions& options, const Metadata& run
 
 }  // namespace
 
+std::vector<std::string> backends_for_scene(const std::vector<std::string>& names, const Scene& scene,
+                                            std::vector<SkippedBackend>& skipped) {
+  std::vector<std::string> runnable;
+  for (const std::string& name : names) {
+    if (const std::string problem = capability_problem(*make_backend(name), scene); !problem.empty()) {
+      const bool noted = std::any_of(skipped.begin(), skipped.end(),
+                                     [&](const SkippedBackend& s) { return s.scene == scene.name && s.backend == name; });
+      if (!noted) skipped.push_back({scene.name, name, problem});
+    } else {
+      runnable.push_back(name);
+    }
+  }
+  return runnable;
+}
+
 std::string timing_reference(const SuiteSettings& settings) {
   const auto in_run = [&](const std::string& name) {
     return std::find(settings.backends.begin(), settings.backends.end(), name) != settings.backends.end();
@@ -480,8 +504,8 @@ RunResults run_suite(const RunOptions& options) {
   if (options.scenes.empty()) {
     for (const SuiteScene& s : options.suite.scenes) {
       if (s.available()) chosen.push_back(choose_scene(s.name, options.suite));
-      else if (!s.optional) throw InputError(options.suite.path, fmt::format("scene '{}': {} not found (add optional = true to skip it when absent)", s.name, s.path));
-      else progress(fmt::format("skipping scene '{}': {} not found", s.name, s.path));
+      else if (!s.optional) throw InputError(options.suite.path, fmt::format("scene '{}': {} not found (add optional = true to skip it when absent)", s.name, s.missing()));
+      else progress(fmt::format("skipping scene '{}': {} not found", s.name, s.missing()));
     }
     if (chosen.empty()) throw InputError(options.suite.path, "no scene of the suite is available");
   }
@@ -491,7 +515,7 @@ RunResults run_suite(const RunOptions& options) {
     progress(fmt::format("[{}/{}] loading {}", i + 1, chosen.size(), chosen[i].arg));
     scenes.push_back({chosen[i], load_chosen_scene(chosen[i])});
     const Scene& s = scenes.back().scene;
-    progress(fmt::format("  {} triangles{}", s.triangles.size(),
+    progress(fmt::format("  {}{}", describe_primitives(s),
                          s.skipped_points + s.skipped_lines
                              ? fmt::format(" ({} points and {} lines skipped)", s.skipped_points, s.skipped_lines)
                              : ""));
@@ -564,6 +588,10 @@ RunResults run_loaded_scenes(const RunOptions& options, const RunChecks& checks,
       rows.insert(rows.end(), scene.rows.begin(), scene.rows.end());
       accuracy_rows.insert(accuracy_rows.end(), scene.accuracy.begin(), scene.accuracy.end());
       if (scene.camera) results.cameras.push_back(*scene.camera);
+      for (const SkippedBackend& s : scene.skipped) {
+        run_description.emplace_back(fmt::format("skipped.{}.{}", toml_key(s.scene), toml_key(s.backend)), s.reason);
+        results.skipped.push_back(s);
+      }
       finished = write_finished_scenes(options, run_description, rows, accuracy_rows, si + 1, scenes.size());
     }
   } catch (const std::exception& e) {

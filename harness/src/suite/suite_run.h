@@ -8,6 +8,7 @@
 
 #include "accuracy/accuracy_csv.h"
 #include "results/results_csv.h"
+#include "scene/scene.h"
 #include "suite/results_table.h"
 #include "suite/suite.h"
 
@@ -46,11 +47,28 @@ inline constexpr const char* kDefaultTimingReference = "embree";
 // else "" (none).
 std::string timing_reference(const SuiteSettings& settings);
 
+// A backend a run did not trace on a scene because the scene has a primitive
+// type the backend's capabilities() lack (plugins: anything not a triangle).
+// Printed when it happens and recorded in the metadata as
+// skipped.<scene>.<backend> = <reason>; the pair has no rows.
+struct SkippedBackend {
+  std::string scene;
+  std::string backend;
+  std::string reason;  // capability_problem (backends/backend.h)
+};
+
+// The backends of `names` (in order, repeats kept) that can model every
+// primitive type of `scene`; one SkippedBackend per other name is appended to
+// `skipped` (once per name). Makes each backend to ask its capabilities().
+std::vector<std::string> backends_for_scene(const std::vector<std::string>& names, const Scene& scene,
+                                            std::vector<SkippedBackend>& skipped);
+
 // What a run measured: its rows as written, and what each scene's camera saw.
 struct RunResults {
   std::vector<ResultRow> rows;
   std::vector<AccuracyRow> accuracy;    // --accuracy runs
   std::vector<CameraCoverage> cameras;  // scenes traced with the primary ray set
+  std::vector<SkippedBackend> skipped;  // backends that cannot model a scene
 };
 
 // Runs the suite and writes the CSV (and the accuracy CSV) with metadata;

@@ -23,12 +23,16 @@
 namespace raybench {
 
 // The first of two crossings t_in <= t_out lying in (lo, tmax], or false.
+// A crossing at t = +inf is none: a box test gives t_exit = +inf to a ray
+// starting inside whose direction is zero or so small that 1/d overflows,
+// which crosses nothing (and a hit at infinite t is no answer: answer_check.h).
 inline bool first_crossing(float t_in, float t_out, float lo, float tmax, float& t) {
-  if (t_in > lo && t_in <= tmax) {
+  constexpr float kNever = std::numeric_limits<float>::infinity();
+  if (t_in > lo && t_in <= tmax && t_in < kNever) {
     t = t_in;
     return true;
   }
-  if (t_out > lo && t_out <= tmax) {
+  if (t_out > lo && t_out <= tmax && t_out < kNever) {
     t = t_out;
     return true;
   }
