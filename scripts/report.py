@@ -1,7 +1,9 @@
 """Turn raybench results and accuracy CSVs into a Markdown report with PNG plots.
 
     scripts/report RESULTS.csv [--out DIR] [--accuracy ACCURACY.csv ...] [--title TEXT]
+                   [--max-error RATE]
     scripts/report --accuracy ACCURACY.csv [--accuracy ACCURACY.csv ...] [--out DIR] [--title TEXT]
+                   [--max-error RATE]
 
 Writes DIR/report.md (default DIR: <dir>/<stem>-report/ of RESULTS.csv, or of the first
 --accuracy file when there is no RESULTS.csv) and, beside it, from RESULTS.csv:
@@ -34,7 +36,16 @@ wrong_prim, fractions of rays, shown as %):
   backend stays within it and answers every invalid ray as a miss (false_hit = 0);
 - a table per scene (as given) with every row: rays, truth hits, error, false miss, false hit,
   wrong prim, ambiguous, self hits, ulp p50/p99/max, Mrays/s; the file's summary names the ray
-  sets whose exact truth has no hit (they can only catch false hits).
+  sets whose exact truth has no hit (they can only catch false hits);
+- tessellation-<scene>.png, for scenes traced also as triangle stand-ins (representation
+  uv<S>x<R>, scene <scene>@uv<S>x<R>; raybench run --tessellate): per ray set, speed against
+  the error rate and against the t error (t_relerr_p99), each backend's analytic form a star and
+  its stand-ins joined coarse to fine, with a table per ray set (triangles, build time and memory
+  from RESULTS.csv when given). Stand-in rows stay out of every other plot and table;
+- with --max-error RATE (a fraction of rays): per scene and ray set, the cheapest tessellation
+  (fewest triangles) whose error stays within RATE for every backend that traced it, or that
+  none does; and the advice: the fastest backend and representation (the scene as loaded or a
+  stand-in) within RATE, or the most accurate one when none is.
 
 The report starts with a "Run" section from the sidecar <csv without .csv>.meta.toml when
 RESULTS.csv has one (an accuracy file's sidecar, if any, is summarised in its own section);
@@ -42,8 +53,9 @@ then the results' plots and one table per ray set; then one section per accuracy
 CSV fields mean "not applicable" and show "-".
 
 Bad input (no input at all, a missing or empty file, missing schema columns, a field that is not
-a number, two accuracy rows for the same scene, transform, ray set, query and backend) prints one
-line `report: error: FILE: problem` on stderr, exits 2 and writes nothing.
+a number, two accuracy rows for the same scene, transform, ray set, query and backend, a stand-in
+row whose scene does not end in @<its representation>, --max-error outside [0, 1] or without
+--accuracy) prints one line `report: error: FILE: problem` on stderr, exits 2 and writes nothing.
 """
 import argparse
 import csv
@@ -74,6 +86,10 @@ ACCURACY_COLUMNS = ["scene", "scale", "offset_x", "offset_y", "offset_z", "rayse
                     "ulp_max", "mrays_s", "mrays_s_min", "mrays_s_max"]
 ACCURACY_NUMERIC = [c for c in ACCURACY_COLUMNS
                     if c not in ("scene", "rayset", "query", "backend", "accuracy_class")]
+# Appended with issue 31; files written before it lack them (read as empty). representation:
+# "triangles", "analytic" or "uv<S>x<R>", a triangle stand-in <scene>@uv<S>x<R> of <scene>.
+ACCURACY_OPTIONAL_NUMERIC = ["t_relerr_p99", "t_relerr_max"]
+STAND_IN = re.compile(r"^uv(?P<segments>[0-9]+)x(?P<rings>[0-9]+)$")
 IDENTITY = (1.0, 0.0, 0.0, 0.0)  # (scale, offset_x, offset_y, offset_z): the scene as given
 INVALID_RAYSET, CONTROL_RAYSET = "invalid-rays", "control-random"
 INVALID_BAR = 2.5  # Embree's bar: an invalid ray costs at most 2.5x a valid one
@@ -156,10 +172,14 @@ def parse_row(path, line, row, numeric):
 
 
 class AccuracyFile:
-    """One --accuracy file: its path, its rows and its sidecar metadata ({} when absent)."""
+    """One --accuracy file: its path, its rows and its sidecar metadata ({} when absent).
+    rows: the scenes traced as themselves; stand_ins: the rows of triangle stand-ins
+    (representation uv<S>x<R>), kept apart for the tessellation study."""
 
     def __init__(self, path, rows, meta):
-        self.path, self.rows, self.meta = path, rows, meta
+        self.path, self.meta = path, meta
+        self.rows = [r for r in rows if r["stands_for"] is None]
+        self.stand_ins = [r for r in rows if r["stands_for"] is not None]
         self.name = os.path.basename(path)
         self.stem = os.path.splitext(self.name)[0]
 
@@ -179,14 +199,33 @@ def read_accuracy(path):
                                    f"{row['rays']!r}")
         row["rays"] = int(row["rays"])
         row["transform"] = (row["scale"], row["offset_x"], row["offset_y"], row["offset_z"])
+        for key in ACCURACY_OPTIONAL_NUMERIC:
+            row.setdefault(key, None)
+        row["stands_for"] = stands_for(path, line, row)
         key = (row["scene"], row["transform"], row["rayset"], row["query"], row["backend"])
         if key in first_line:
             raise InputError(path, f"line {line}: same scene, scale, offset, rayset, query and "
                                    f"backend as line {first_line[key]}")
         first_line[key] = line
 
-    rows = read_table(path, ACCURACY_COLUMNS, ACCURACY_NUMERIC, check)
+    rows = read_table(path, ACCURACY_COLUMNS, ACCURACY_NUMERIC + ACCURACY_OPTIONAL_NUMERIC, check)
     return AccuracyFile(path, rows, read_meta(path))
+
+
+def stands_for(path, line, row):
+    """The scene a stand-in row's triangles stand for (its name without @uv<S>x<R>), None for
+    a scene traced as itself. Sets row["representation"] ("" in older files)."""
+    representation = row.setdefault("representation", "")
+    if representation in ("", "triangles", "analytic"):
+        return None
+    if not STAND_IN.match(representation):
+        raise InputError(path, f"line {line}: column representation: expected triangles, "
+                               f"analytic or uv<S>x<R>, got {representation!r}")
+    suffix = "@" + representation
+    if not row["scene"].endswith(suffix) or row["scene"] == suffix:
+        raise InputError(path, f"line {line}: representation {representation} but scene "
+                               f"{row['scene']!r} does not end in {suffix}")
+    return row["scene"][:-len(suffix)]
 
 
 def meta_path(csv_path):
@@ -1281,6 +1320,281 @@ def invalid_rays_plot(acc, colors, used):
                 extra=invalid_rays_table(costs))
 
 
+# ---------------------------------------------------------------------------------------------
+# The tessellation study (issue 31): analytic scenes against their triangle stand-ins, and the
+# advice within an error budget
+
+
+def t_error(row):
+    """The depth error of a row: |t - t_exact| / t_exact, 99th percentile over the rays both the
+    referee and the backend hit (None for occlusion queries and older files)."""
+    return row.get("t_relerr_p99")
+
+
+def resolution(representation):
+    """uv<S>x<R> -> triangles per sphere, S (2R - 2): what a stand-in costs; 0 for the analytic
+    form, so that it sorts first."""
+    match = STAND_IN.match(representation)
+    if not match:
+        return 0
+    return int(match["segments"]) * (2 * int(match["rings"]) - 2)
+
+
+def fmt_relerr(value):
+    """A relative error to two significant digits: 0.017, 1.3e-3, 1e-7."""
+    if value is None or math.isnan(value):
+        return DASH
+    return fmt_short(float(f"{value:.2g}"))
+
+
+def representation_label(row):
+    return row["representation"] or "as loaded"
+
+
+def results_index(results_rows):
+    """(scene, ray set, backend) -> the results row with the fewest threads: build time,
+    memory and triangle counts for the study's table (accuracy rows are one thread)."""
+    index = {}
+    for r in sorted(results_rows, key=lambda r: r["threads"]):
+        index.setdefault((r["scene"], r["rayset"], r["backend"]), r)
+    return index
+
+
+def study_points(rows):
+    """One point per (backend, representation) of one ray set: error rate, t error, speed."""
+    points = []
+    for r in rows:
+        error = error_rate(r)
+        if error is None or not r["mrays_s"]:
+            continue
+        points.append({"backend": r["backend"], "representation": representation_label(r),
+                       "scene": r["scene"], "error": error, "t_error": t_error(r),
+                       "speed": r["mrays_s"], "rays": r["rays"], "row": r})
+    return points
+
+
+def tessellation_groups(acc):
+    """(scene, [(ray-set label, rows)]) for every scene of an accuracy file with stand-ins: the
+    scene's rows and its stand-ins' rows per ray set and query, in file order."""
+    groups = []
+    for scene in ordered(r["stands_for"] for r in acc.stand_ins):
+        rows = [r for r in acc.rows if r["scene"] == scene] + \
+               [r for r in acc.stand_ins if r["stands_for"] == scene]
+        by_rayset = group_by(rows, lambda r: rayset_label(r["rayset"], r["query"]))
+        groups.append((scene, list(by_rayset.items())))
+    return groups
+
+
+def cheapest_within(points, budget):
+    """The stand-in with the fewest triangles whose error stays within `budget` for every backend
+    that traced it, as (representation, worst error, fastest point there); None if none."""
+    stand_ins = group_by([p for p in points if STAND_IN.match(p["representation"])],
+                         lambda p: p["representation"])
+    for representation in sorted(stand_ins, key=resolution):
+        group = stand_ins[representation]
+        worst = max(p["error"] for p in group)
+        if worst <= budget:
+            return representation, worst, max(group, key=lambda p: p["speed"])
+    return None
+
+
+def cheapest_sentence(label, points, budget):
+    stand_ins = [p for p in points if STAND_IN.match(p["representation"])]
+    if not stand_ins:
+        return f"- {label}: no stand-in was timed."
+    found = cheapest_within(points, budget)
+    if found:
+        representation, worst, fastest = found
+        return (f"- {label}: **{representation}** is the cheapest tessellation within "
+                f"{fmt_rate(budget)} (at most {fmt_rate(worst)} of rays answered wrongly by any "
+                f"backend; fastest there {fastest['backend']} at {fmt_sig(fastest['speed'])} "
+                "Mrays/s).")
+    best = min(stand_ins, key=lambda p: (p["error"], -p["speed"]))
+    return (f"- {label}: **no tessellation** stays within {fmt_rate(budget)}: the most accurate "
+            f"stand-in, {best['representation']} with {best['backend']}, answers "
+            f"{fmt_rate(best['error'])} of rays wrongly.")
+
+
+def advice(points, budget):
+    """The fastest point whose error stays within the budget, or None."""
+    within = [p for p in points if p["error"] <= budget]
+    return max(within, key=lambda p: (p["speed"], -p["error"])) if within else None
+
+
+def study_table(rows, index):
+    header = ["backend", "representation", "triangles", "Mrays/s", "error", "false miss",
+              "false hit", "wrong prim", "t relerr p99", "t relerr max", "ulp p99", "build ms",
+              "MiB"]
+    backends = ordered(r["backend"] for r in rows)
+    rows = sorted(rows, key=lambda r: (backends.index(r["backend"]),
+                                       resolution(r["representation"])))
+    cells = []
+    for r in rows:
+        run = index.get((r["scene"], r["rayset"], r["backend"]), {})
+        cells.append([md_escape(r["backend"]), md_escape(representation_label(r)),
+                      fmt_count(run.get("triangles")) or DASH, fmt_sig(r["mrays_s"]),
+                      fmt_rate(error_rate(r)), fmt_rate(r["false_miss"]), fmt_rate(r["false_hit"]),
+                      fmt_rate(r["wrong_prim"]), fmt_relerr(t_error(r)), fmt_relerr(r["t_relerr_max"]),
+                      fmt_ulp(r["ulp_p99"]), fmt_sig(run.get("build_ms")),
+                      fmt_mib(run.get("memory_bytes"))])
+    return md_table(header, cells, 2)
+
+
+def plot_tessellation(path, panels, colors, title, budget):
+    """panels: [(ray-set label, [point])]. Per ray set, speed against the wrong-answer rate
+    (left) and against the t error (right, closest-hit ray sets only): each backend a colour,
+    its stand-ins joined coarse to fine by a line, its analytic form a star."""
+    plt = pyplot()
+    from matplotlib.lines import Line2D
+    fig, axes = plt.subplots(len(panels), 2, figsize=(10.5, 3.6 * len(panels) + 1.0),
+                             layout="constrained", squeeze=False)
+    backends = ordered(p["backend"] for _, points in panels for p in points)
+    for (label, points), (left, right) in zip(panels, axes):
+        for ax, key in ((left, "error"), (right, "t_error")):
+            shown = [p for p in points if p[key] is not None]
+            if not shown:
+                ax.set_visible(False)
+                continue
+            for backend in backends:
+                mine = [p for p in shown if p["backend"] == backend]
+                line = sorted((p for p in mine if STAND_IN.match(p["representation"])),
+                              key=lambda p: resolution(p["representation"]))
+                if line:
+                    ax.plot([p[key] for p in line], [p["speed"] for p in line], marker="o",
+                            markersize=5, markerfacecolor="white", color=colors[backend],
+                            linewidth=1.2, zorder=2)
+                for p in mine:
+                    analytic = not STAND_IN.match(p["representation"])
+                    if analytic:
+                        ax.scatter([p[key]], [p["speed"]], marker="*", s=140, zorder=3,
+                                   color=colors[backend], edgecolors="black", linewidths=0.6)
+                    ax.annotate(p["representation"], (p[key], p["speed"]), xytext=(4, 3),
+                                textcoords="offset points", fontsize=7, color="0.25")
+            values = [p[key] for p in shown]
+            if key == "error":
+                error_axis(ax, "x", values + ([budget] if budget is not None else []),
+                           max(p["rays"] or 0 for p in shown), percent=True)
+                ax.set_xlabel("error rate: false miss + false hit + wrong prim (% of rays, symlog)")
+                if budget is not None:
+                    ax.axvline(budget, color="black", linestyle="--", linewidth=1.0, zorder=1)
+            else:
+                # Below 1e-7 (a float ulp is 6e-8 to 1.2e-7 relative) the axis is linear.
+                positive = [v for v in values if v > 0]
+                threshold = 10.0 ** math.floor(math.log10(min(positive + [1e-7])))
+                top = max(max(values) * 4, threshold * 100)
+                ax.set_xscale("symlog", linthresh=threshold, linscale=1.0)
+                ax.set_xlim(-0.6 * threshold, top)
+                symlog_ticks(ax.xaxis, threshold, top, MAX_X_LABELS)
+                from matplotlib.ticker import FuncFormatter
+                ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: fmt_short(v)))
+                ax.set_xlabel("t error: |t \u2212 t_exact| / t_exact, p99 (symlog)")
+            speeds = [p["speed"] for p in shown]
+            if wide_range(speeds, 10):
+                log_axis(ax)
+                ax.set_ylim(min(speeds) / 1.5, max(speeds) * 1.5)
+            else:
+                ax.set_ylim(0, max(speeds) * 1.2)
+            ax.set_ylabel("throughput (Mrays/s)")
+            ax.set_title(label)
+            ax.grid(alpha=0.3, zorder=0)
+    handles = [Line2D([], [], color=colors[b], marker="o", markerfacecolor="white", label=b)
+               for b in backends]
+    handles += [Line2D([], [], color="0.3", marker="*", markersize=11, linestyle="none",
+                       label="analytic (as loaded)"),
+                Line2D([], [], color="0.3", marker="o", markerfacecolor="white",
+                       label="stand-ins, coarse to fine")]
+    if budget is not None:
+        handles.append(Line2D([], [], color="black", linestyle="--",
+                              label=f"budget {fmt_rate(budget)}"))
+    anchor = next((ax for ax in reversed(list(axes.flat)) if ax.get_visible()), axes.flat[0])
+    anchor.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    fig.suptitle(wrap_title(title, fig))
+    save(fig, path)
+
+
+def tessellation_section(acc, colors, used, results_rows, budget):
+    """The study of one accuracy file: per scene with stand-ins, its plot, the cheapest
+    tessellation within the budget per ray set, and the numbers. ([], []) when it has none."""
+    groups = tessellation_groups(acc)
+    if not groups:
+        return [], []
+    index = results_index(results_rows)
+    plots, lines = [], ["### Tessellation study", "", TESSELLATION_INTRO, ""]
+    if budget is None:
+        lines += [NO_BUDGET_LINE, ""]
+    for scene, by_rayset in groups:
+        panels = [(label, study_points(rows)) for label, rows in by_rayset]
+        panels = [(label, points) for label, points in panels if points]
+        if not panels:
+            continue
+        title = (f"Tessellation study: {scene} ({acc.name}, 1 thread): speed against error, "
+                 "analytic (star) and stand-ins")
+        filename = unique_name(f"tessellation-{safe_name(scene)}", used)
+        plots.append(Plot("Tessellation study", scene, None, filename,
+                          lambda path, p=panels, t=title: plot_tessellation(
+                              path, p, colors, t, budget)))
+        lines += image_lines(md_escape(scene), filename, 4)
+        if budget is not None:
+            lines += [cheapest_sentence(label, points, budget) for label, points in panels] + [""]
+        for label, rows in by_rayset:
+            lines += [f"{label}:", ""] + study_table(rows, index)
+    return plots, lines
+
+
+def advice_section(acc, budget):
+    """Per scene (as given) and ray set: the fastest backend and representation whose error
+    stays within the budget, or the most accurate one when none does."""
+    lines = [f"### Advice within {fmt_rate(budget)} of rays answered wrongly", "", ADVICE_INTRO, ""]
+    cells = []
+    for scene, transforms in by_scene_transform(acc.rows).items():
+        base = base_transform(transforms)
+        if base is None:
+            continue
+        rows = transforms[base]
+        names = {r["scene"] for r in rows}
+        rows = rows + [r for r in acc.stand_ins if r["stands_for"] in names]
+        heading = scene + ("" if base == IDENTITY else f" ({fmt_transform(base)})")
+        for label, group in group_by(rows, lambda r: rayset_label(r["rayset"], r["query"])).items():
+            points = study_points(group)
+            if not points:
+                continue
+            best = advice(points, budget)
+            if best:
+                cells.append([md_escape(heading), md_escape(label), md_escape(best["backend"]),
+                              md_escape(best["representation"]), fmt_sig(best["speed"]),
+                              fmt_rate(best["error"]), DASH])
+            else:
+                closest = min(points, key=lambda p: (p["error"], -p["speed"]))
+                cells.append([md_escape(heading), md_escape(label), "**none within budget**",
+                              DASH, DASH, DASH,
+                              f"most accurate: {md_escape(closest['backend'])} "
+                              f"{md_escape(closest['representation'])} at "
+                              f"{fmt_rate(closest['error'])}"])
+    header = ["scene", "ray set", "fastest backend", "representation", "Mrays/s", "error", "note"]
+    return lines + md_table(header, cells, 4)
+
+
+TESSELLATION_INTRO = (
+    "Scenes with analytic primitives were also traced as triangle stand-ins "
+    "(`<scene>@uv<S>x<R>`: each sphere a UV sphere of S segments by R rings, each box 12 "
+    "triangles) with the scene's own rays, judged against the analytic scene's exact referee: "
+    "a stand-in triangle's hit counts as a hit on the primitive it stands for. Per ray set, "
+    "speed against the error rate (false miss + false hit + wrong prim, % of rays: misses and "
+    "hits near silhouettes) and against the t error (|t \u2212 t_exact| / t_exact, 99th "
+    "percentile over the rays both hit); each backend's analytic form is a star, its stand-ins "
+    "are joined from coarse to fine. The cheapest tessellation is the one with the fewest "
+    "triangles whose error stays within the budget for every backend that traced it. Triangles, "
+    "build time and memory come from the results CSV when it is given.")
+NO_BUDGET_LINE = ("Give `--max-error RATE` (a fraction of rays, e.g. 0.001 for 0.1 %) for the "
+                  "cheapest tessellation within that budget and the advice per scene.")
+ADVICE_INTRO = (
+    "Per scene (as given) and ray set: of every backend and representation traced (the scene "
+    "as loaded, and its stand-ins where it has them), the fastest (Mrays/s, one thread) whose "
+    "measured error rate (false miss + false hit + wrong prim) stays within the budget; when "
+    "none does, the most accurate one is named instead. Untimed rows (the referee) are not "
+    "candidates.")
+
+
 SECTION_INTROS = {
     "Speed versus error": (
         "One figure per scene, one panel per ray set; each point is a backend or kernel "
@@ -1322,13 +1636,17 @@ def accuracy_summary(acc):
     scenes = ordered(scene_family(r["scene"]) for r in rows)
     backends = ordered(r["backend"] for r in rows)
     raysets = ordered(r["rayset"] for r in rows)
-    lines = [f"- File: `{acc.name}`, {len(rows):,} rows (one thread each)",
+    lines = [f"- File: `{acc.name}`, {len(rows) + len(acc.stand_ins):,} rows (one thread each)",
              f"- Scenes ({len(scenes)}): " + ", ".join(f"`{s}`" for s in scenes),
              f"- Backends ({len(backends)}): " + ", ".join(f"`{b}`" for b in backends),
              f"- Ray sets ({len(raysets)}): " + ", ".join(f"`{r}`" for r in raysets)]
     if acc.meta:
         lines.append(f"- Metadata: `{os.path.basename(meta_path(acc.path))}`")
         lines += [f"- {label}: {text}" for label, text in run_facts(acc.meta) if text]
+    if acc.stand_ins:
+        stand_ins = ordered(r["representation"] for r in acc.stand_ins)
+        lines.append(f"- Stand-ins ({len(acc.stand_ins):,} rows, in the tessellation study): "
+                     + ", ".join(f"`{s}`" for s in sorted(stand_ins, key=resolution)))
     no_hits = miss_only_raysets(rows)
     if no_hits:
         lines.append("- Ray sets with no hit in the exact truth (they can only catch false hits; "
@@ -1344,9 +1662,10 @@ def accuracy_summary(acc):
         f"in float ulps at t_exact, over rays both hit. {DASH} = not applicable.", ""]
 
 
-def accuracy_section(acc, colors, used):
+def accuracy_section(acc, colors, used, results_rows=(), budget=None):
     """The report's part for one accuracy file: its plots (Pareto per scene, stability sweep,
-    parameter sweeps, invalid-ray cost) and then its rows as tables, one per scene."""
+    parameter sweeps, invalid-ray cost), its rows as tables, one per scene, then the
+    tessellation study (scenes with stand-ins) and, given a budget, the advice."""
     plots = accuracy_pareto_plots(acc, colors, used)
     plots += stability_plots(acc, colors, used)
     plots += parameter_plots(acc, colors, used)
@@ -1370,6 +1689,11 @@ def accuracy_section(acc, colors, used):
             continue
         heading = scene + ("" if base == IDENTITY else f" ({fmt_transform(base)})")
         lines += [f"#### {md_escape(heading)}", ""] + accuracy_table(transforms[base])
+    study_plots, study_lines = tessellation_section(acc, colors, used, results_rows, budget)
+    plots += study_plots
+    lines += study_lines
+    if budget is not None:
+        lines += advice_section(acc, budget)
     return plots, lines
 
 
@@ -1482,6 +1806,11 @@ NO_ACCURACY_LINE = ("**No accuracy file given, so no error rates against ground 
                     "the exact referee; `scripts/accuracy` runs the whole accuracy suite) and "
                     "pass it as `scripts/report RESULTS.csv --accuracy accuracy.csv`. Ray sets "
                     "on which every backend agrees with Embree are not plotted here.")
+NO_ACCURACY_STUDY_LINE = (
+    "The run traced triangle stand-ins (`<scene>@uv<S>x<R>`; their rows are in the plots and "
+    "tables above as scenes of their own), but what they get wrong against the analytic scene "
+    "needs its exact referee: run with `--accuracy accuracy.csv` and pass it with "
+    "`--accuracy` (and `--max-error RATE` for the advice).")
 FALLBACK_ERROR = ("Below, the error is 1 \u2212 agree_hit, disagreement with Embree, not an "
                   "error against ground truth; on must-hit ray sets (a `leaks` value) it is "
                   "leaks / rays, which is one.")
@@ -1507,6 +1836,8 @@ def results_part(csv_path, rows, meta, colors, with_pareto, used):
     lines += plots_section(plots, intro)
     if with_pareto and not any(p.section == "Speed versus error" for p in plots):
         lines += ["## Speed versus error", "", NO_ACCURACY_LINE, ""]
+    if with_pareto and any(STAND_IN.match(r.get("representation") or "") for r in rows):
+        lines += ["## Tessellation study", "", NO_ACCURACY_STUDY_LINE, ""]
     lines += tables_section(rows, scenes, backends, raysets)
     return plots, lines
 
@@ -1572,10 +1903,31 @@ def parse_args(argv):
                              "Without it the speed-versus-error plots use 1 - agree_hit "
                              "(disagreement with Embree)")
     parser.add_argument("--title", metavar="TEXT", help="report title")
+    parser.add_argument("--max-error", metavar="RATE", type=error_budget,
+                        help="an error budget, the fraction of rays a backend may answer wrongly "
+                             "(false miss + false hit + wrong prim), e.g. 0.001 for 0.1 %%: the "
+                             "tessellation study then names the cheapest tessellation within it, "
+                             "and the advice, per scene and ray set, the fastest backend and "
+                             "representation within it (needs --accuracy)")
     args = parser.parse_args(argv)
     if args.csv is None and not args.accuracy:
         parser.error("nothing to report: give RESULTS.csv, --accuracy ACCURACY.csv, or both")
+    if args.max_error is not None and not args.accuracy:
+        parser.error("--max-error needs --accuracy ACCURACY.csv: the error is judged by the "
+                     "exact referee (raybench run --accuracy)")
     return args
+
+
+def error_budget(text):
+    """--max-error: a finite fraction in [0, 1]."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"expected a fraction of rays from 0 to 1, e.g. 0.001, "
+                                         f"got {text!r}")
+    return value
 
 
 def default_title(csv_path, accuracy):
@@ -1606,7 +1958,8 @@ def main(argv):
         lines += part_lines
     for acc in accuracy:
         own = ordered(r["backend"] for r in acc.rows if r["backend"] not in backends)
-        part_plots, part_lines = accuracy_section(acc, backend_colors(backends + own), used)
+        part_plots, part_lines = accuracy_section(acc, backend_colors(backends + own), used,
+                                                  rows, args.max_error)
         plots += part_plots
         lines += part_lines
     write_report(out_dir, plots, "\n".join(lines).rstrip() + "\n")

@@ -2,7 +2,9 @@
 report and every PNG it links exist and are real images, the tables hold every (scene, backend)
 pair, accuracy files (alone, several, or beside a results CSV) give the speed-versus-error,
 stability-sweep, ray-set-parameter and invalid-ray plots and tables, and bad input exits 2 with
-one line on stderr and writes nothing. Without an accuracy file the report says so and how to
+one line on stderr and writes nothing. The tessellation study (stand-ins of an analytic scene)
+gets its own plot and tables, the cheapest tessellation within --max-error for every backend,
+and the advice names the fastest backend and representation within it. Without an accuracy file the report says so and how to
 make one; the tables show ties and t error; the symlog axes' tick labels do not overlap. The data behind the accuracy plots (what is pooled, what
 is left out, the invalid-ray cost) is also checked directly on report.py's functions.
 
@@ -673,6 +675,170 @@ class SymlogAxisTestCase(unittest.TestCase):
             report.pyplot().close(fig)
 
 
+# Issue 31: the tessellation study. "balls" has analytic spheres, traced as they are and as three
+# stand-ins, coarse (fast, wrong) to fine (slow, nearly right); bvh2 is worse than embree on
+# uv32x16 so that "within the budget for every backend" matters.
+STUDY_COLUMNS = ACCURACY_COLUMNS + ["t_relerr_p99", "t_relerr_max", "representation"]
+STAND_INS = {"uv8x4": 0.05, "uv32x16": 0.004, "uv128x64": 0.0003}
+STUDY_SPEED = {"embree": 10.0, "bvh2": 6.0}
+
+
+def study_rows():
+    rows = []
+    for rayset, query in RAYSETS.items():
+        occluded = query == "occluded"
+        for backend, speed in STUDY_SPEED.items():
+            rows.append(accuracy_row("balls", rayset, backend, speed, query=query,
+                                     representation="analytic",
+                                     wrong_prim="" if occluded else 0,
+                                     t_relerr_p99="" if occluded else 1e-7,
+                                     t_relerr_max="" if occluded else 4e-7))
+            for i, (representation, error) in enumerate(STAND_INS.items()):
+                if backend == "bvh2" and representation == "uv32x16":
+                    error = 0.02
+                rows.append(accuracy_row(
+                    "balls@" + representation, rayset, backend, speed * (1.6 - 0.3 * i),
+                    query=query, representation=representation, false_miss=error * 0.6,
+                    false_hit=error * 0.4, wrong_prim="" if occluded else 0,
+                    t_relerr_p99="" if occluded else error / 3,
+                    t_relerr_max="" if occluded else error))
+    # A scene without analytic primitives: advice, but no study.
+    for backend, speed in STUDY_SPEED.items():
+        rows.append(accuracy_row("bunny", "primary", backend, speed / 2, representation="triangles",
+                                 false_miss=0 if backend == "embree" else 0.01,
+                                 t_relerr_p99=1e-7, t_relerr_max=1e-6))
+    return rows
+
+
+def study_results_rows():
+    """The run beside the accuracy file: triangles, build time and memory per representation."""
+    rows = []
+    triangles = {"balls": 20000, "balls@uv8x4": 25760, "balls@uv32x16": 131600,
+                 "balls@uv128x64": 2027520, "bunny": 69451}
+    for r in study_rows():
+        rows.append({**{c: "" for c in COLUMNS}, "scene": r["scene"],
+                     "triangles": triangles[r["scene"]], "rayset": r["rayset"],
+                     "query": r["query"], "rays": 4096, "backend": r["backend"], "threads": 1,
+                     "build_ms": triangles[r["scene"]] / 1000, "memory_bytes": 2 ** 20,
+                     "mrays_s": r["mrays_s"], "mrays_s_min": r["mrays_s"],
+                     "mrays_s_max": r["mrays_s"], "ratio_to_embree": 1, "hit_rate": 0.5,
+                     "agree_hit": 1, "agree_prim": 1, "representation": r["representation"]})
+    return rows
+
+
+class TessellationStudyTestCase(ReportTestCase):
+    """The tessellation study and the advice, with and without a budget."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.dir = cls.tmp.name
+        write_csv(cls.path("study.csv"), study_rows(), STUDY_COLUMNS)
+        write_csv(cls.path("run.csv"), study_results_rows(), COLUMNS + ["representation"])
+        cls.budget = run_report(cls.path("run.csv"), "--accuracy", cls.path("study.csv"),
+                                "--max-error", "0.001", "--out", cls.path("budget-out"))
+        cls.no_budget = run_report("--accuracy", cls.path("study.csv"),
+                                   "--out", cls.path("no-budget-out"))
+        cls.results_only = run_report(cls.path("run.csv"), "--out", cls.path("results-out"))
+
+    test_default_out_dir_and_relative_path = None
+    test_tables_hold_every_scene_backend_pair = None
+    test_empty_fields_show_a_dash = None
+    test_plots_per_rayset_and_fallback_pareto = None
+    test_run_section_from_meta = None
+    test_several_thread_counts = None
+    test_accuracy_file_gives_pareto_plots = None
+    test_must_hit_rayset_shows_leaks = None
+    test_help = None
+    test_without_accuracy_file_the_report_says_so_and_how_to_make_one = None
+    test_panels_where_every_backend_is_at_zero_are_left_out = None
+    test_tables_show_ties_and_t_error = None
+
+    def test_the_study_plots_each_scene_with_stand_ins(self):
+        markdown, links = self.assertGoodReport(self.budget, self.path("budget-out"))
+        self.assertIn("tessellation-balls.png", links)
+        self.assertNotIn("tessellation-bunny.png", links)
+        study = section(markdown, "### Tessellation study")
+        self.assertIn("\n#### balls\n", study)
+        self.assertIn("- Stand-ins (12 rows, in the tessellation study): `uv8x4`, `uv32x16`, "
+                      "`uv128x64`", markdown)
+
+    def test_stand_ins_stay_out_of_the_other_plots_and_tables(self):
+        markdown = self.read_report(self.path("budget-out"))
+        by_scene = section(markdown, "### Results by scene")
+        balls = table_rows(section(by_scene, "#### balls"))
+        self.assertEqual(len(balls), 4, "the analytic scene's rows only")
+        self.assertNotIn("uv8x4", section(markdown, "### Speed versus error"))
+
+    def test_the_table_joins_triangles_build_time_and_memory_from_the_run(self):
+        markdown = self.read_report(self.path("budget-out"))
+        rows = table_rows(section(section(markdown, "### Tessellation study"), "#### balls"))
+        fine = [r for r in rows if r["representation"] == "uv128x64" and r["backend"] == "bvh2"]
+        self.assertEqual(len(fine), 2, "one per ray set")
+        self.assertEqual(fine[0]["triangles"], "2.0M")
+        self.assertEqual(fine[0]["build ms"], "2,028")
+        self.assertEqual(fine[0]["MiB"], "1")
+        self.assertEqual(fine[0]["error"], "0.03 %")
+        self.assertEqual(fine[0]["t relerr p99"], "1e-4")
+        self.assertEqual(fine[1]["t relerr p99"], report.DASH, "shadow rays have no t")
+        # Coarse to fine per backend, the analytic form first.
+        self.assertEqual([r["representation"] for r in rows[:4]],
+                         ["analytic", "uv8x4", "uv32x16", "uv128x64"])
+
+    def test_the_cheapest_tessellation_is_within_the_budget_for_every_backend(self):
+        study = section(self.read_report(self.path("budget-out")), "### Tessellation study")
+        self.assertIn("- primary: **uv128x64** is the cheapest tessellation within 0.1 % (at most "
+                      "0.03 % of rays answered wrongly by any backend; fastest there embree at "
+                      "10 Mrays/s).", study)
+        points = report.study_points([r for r in report.read_accuracy(
+            self.path("study.csv")).stand_ins if r["rayset"] == "primary"])
+        # embree's uv32x16 is within 0.5 %, bvh2's is not: uv32x16 does not qualify.
+        self.assertEqual(report.cheapest_within(points, 0.005)[0], "uv128x64")
+        self.assertEqual(report.cheapest_within(points, 0.02)[0], "uv32x16")
+        self.assertEqual(report.cheapest_within(points, 0.1)[0], "uv8x4")
+        self.assertIsNone(report.cheapest_within(points, 1e-4))
+        self.assertIn("**no tessellation** stays within 0.01 %: the most accurate stand-in, "
+                      "uv128x64 with embree, answers 0.03 % of rays wrongly.",
+                      report.cheapest_sentence("primary", points, 1e-4))
+
+    def test_the_advice_names_the_fastest_backend_and_representation_within_the_budget(self):
+        advice = table_rows(section(self.read_report(self.path("budget-out")),
+                                    "### Advice within 0.1 % of rays answered wrongly"))
+        by_key = {(r["scene"], r["ray set"]): r for r in advice}
+        self.assertEqual(set(by_key), {("balls", "primary"), ("balls", "shadow (any hit)"),
+                                       ("bunny", "primary")})
+        # embree analytic (10 Mrays/s, 0) ties embree uv128x64 (10, 0.03 %): the exact one wins.
+        self.assertEqual((by_key["balls", "primary"]["fastest backend"],
+                          by_key["balls", "primary"]["representation"]), ("embree", "analytic"))
+        self.assertEqual(by_key["bunny", "primary"]["fastest backend"], "embree")
+        points = report.study_points(report.read_accuracy(self.path("study.csv")).stand_ins)
+        fastest = report.advice(points, 0.1)
+        self.assertEqual((fastest["backend"], fastest["representation"]), ("embree", "uv8x4"))
+        self.assertIsNone(report.advice(points, 1e-5))
+
+    def test_none_within_the_budget_names_the_most_accurate(self):
+        result = run_report("--accuracy", self.path("study.csv"), "--max-error", "0",
+                            "--out", self.path("zero-out"))
+        self.assertEqual(result.returncode, 0, result.stderr)
+        advice = table_rows(section(self.read_report(self.path("zero-out")),
+                                    "### Advice within 0 of rays answered wrongly"))
+        bunny = [r for r in advice if r["scene"] == "bunny"][0]
+        self.assertEqual(bunny["fastest backend"], "embree", "error 0 is within a budget of 0")
+        study = section(self.read_report(self.path("zero-out")), "### Tessellation study")
+        self.assertIn("- primary: **no tessellation** stays within 0", study)
+
+    def test_without_a_budget_the_report_says_how_to_give_one(self):
+        markdown, links = self.assertGoodReport(self.no_budget, self.path("no-budget-out"))
+        self.assertIn("tessellation-balls.png", links)
+        self.assertIn(report.NO_BUDGET_LINE, markdown)
+        self.assertNotIn("### Advice", markdown)
+        self.assertNotIn("is the cheapest tessellation within", markdown)
+
+    def test_without_an_accuracy_file_the_study_says_what_it_needs(self):
+        markdown, _ = self.assertGoodReport(self.results_only, self.path("results-out"))
+        self.assertIn("## Tessellation study\n\n" + report.NO_ACCURACY_STUDY_LINE, markdown)
+
+
 class BadInputTestCase(unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
@@ -754,6 +920,30 @@ class BadInputTestCase(unittest.TestCase):
         rows[0]["scale"] = ""
         path = self.write_accuracy("acc.csv", rows)
         self.assertBadInput(path, "--accuracy", path)
+
+    def test_stand_in_whose_scene_does_not_name_its_representation(self):
+        rows = study_rows()
+        rows[1]["scene"] = "balls"  # representation uv8x4
+        path = self.write_accuracy("acc.csv", rows, STUDY_COLUMNS)
+        self.assertBadInput(path, "--accuracy", path)
+        rows[1].update(scene="balls@uv8x4", representation="tessellated")
+        path = self.write_accuracy("acc.csv", rows, STUDY_COLUMNS)
+        self.assertBadInput(path, "--accuracy", path)
+
+    def test_max_error_must_be_a_fraction_and_needs_an_accuracy_file(self):
+        acc = self.write_accuracy("acc.csv", study_rows(), STUDY_COLUMNS)
+        for bad in ("-0.1", "2", "nan", "inf", "1%", "x"):
+            result = run_report("--accuracy", acc, "--max-error", bad,
+                                "--out", os.path.join(self.dir, "out"))
+            self.assertEqual(result.returncode, 2, bad)
+            self.assertEqual(len(result.stderr.splitlines()), 1, result.stderr)
+            self.assertIn("--max-error", result.stderr)
+            self.assertFalse(os.path.exists(os.path.join(self.dir, "out")))
+        result = run_report(self.good, "--max-error", "0.01", "--out", os.path.join(self.dir, "out"))
+        self.assertEqual(result.returncode, 2)
+        self.assertEqual(result.stderr.strip(), "report: error: --max-error needs --accuracy "
+                         "ACCURACY.csv: the error is judged by the exact referee (raybench run "
+                         "--accuracy)")
 
     def test_accuracy_duplicate_row(self):
         rows = scene_accuracy_rows()

@@ -73,6 +73,9 @@ TEST(Judge, CountsEachKindOfErrorAgainstTheReferee) {
   // t errors over the rays answered right: 0 ulp and 1 ulp.
   EXPECT_DOUBLE_EQ(row.ulp_p50, 0.0);
   EXPECT_DOUBLE_EQ(row.ulp_max, 1.0);
+  // And in relative terms, |t - t_exact| / t_exact: one ulp above 1 is 2^-23.
+  EXPECT_DOUBLE_EQ(row.t_relerr_max, std::ldexp(1.0, -23));
+  EXPECT_DOUBLE_EQ(row.t_relerr_p99, std::ldexp(1.0, -23));
 }
 
 TEST(Judge, ASecondaryRayHittingItsOwnTriangleIsASelfIntersection) {
@@ -191,6 +194,47 @@ TEST(AccuracyCsv, RoundTripsAndRejectsABadNumber) {
   std::ofstream(dir.file("bad.csv")) << fmt::format("{}\n", fmt::join(accuracy_columns(), ",")) << "s,x"
                                      << std::string(accuracy_columns().size() - 2, ',') << "\n";
   EXPECT_NE(testing::input_error_of([&] { read_accuracy_csv(dir.file("bad.csv")); }).find("not a number"), std::string::npos);
+}
+
+// Issue 31: a stand-in's rows say what was traced and how far its depths lie
+// from the exact ones; files written before these columns still read.
+TEST(AccuracyCsv, TheRepresentationAndRelativeTErrorRoundTripAndOlderFilesRead) {
+  testing::TempDir dir;
+  AccuracyRow r;
+  r.scene = "balls@uv8x4";
+  r.rayset = "primary";
+  r.query = "intersect";
+  r.backend = "bvh2";
+  r.rays = 10;
+  r.t_relerr_p99 = 0.015;
+  r.t_relerr_max = 0.0625;
+  r.representation = "uv8x4";
+  write_accuracy_csv(dir.file("a.csv"), {r});
+  const std::vector<std::string>& columns = accuracy_columns();
+  ASSERT_GE(columns.size(), 3u);
+  EXPECT_EQ(columns[columns.size() - 3], "t_relerr_p99");
+  EXPECT_EQ(columns[columns.size() - 2], "t_relerr_max");
+  EXPECT_EQ(columns.back(), "representation");
+  const std::vector<AccuracyRow> back = read_accuracy_csv(dir.file("a.csv"));
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_EQ(back[0].representation, "uv8x4");
+  EXPECT_EQ(back[0].t_relerr_p99, 0.015);
+  EXPECT_EQ(back[0].t_relerr_max, 0.0625);
+  // The schema up to mrays_s_max, as results/accuracy.csv was written before issue 31.
+  const std::vector<std::string> old_columns(columns.begin(), columns.end() - 3);
+  std::vector<std::string> fields(old_columns.size(), "");
+  fields[0] = "sphere";
+  for (const char* c : {"scale", "rays"}) fields[std::find(old_columns.begin(), old_columns.end(), c) - old_columns.begin()] = "1";
+  std::ofstream(dir.file("old.csv")) << fmt::format("{}\n{}\n", fmt::join(old_columns, ","), fmt::join(fields, ","));
+  const std::vector<AccuracyRow> old = read_accuracy_csv(dir.file("old.csv"));
+  ASSERT_EQ(old.size(), 1u);
+  EXPECT_EQ(old[0].scene, "sphere");
+  EXPECT_EQ(old[0].representation, "");
+  EXPECT_TRUE(std::isnan(old[0].t_relerr_max));
+  // An older column is still required.
+  std::ofstream(dir.file("broken.csv")) << "scene,rays\nsphere,1\n";
+  EXPECT_NE(testing::input_error_of([&] { read_accuracy_csv(dir.file("broken.csv")); }).find("missing column"),
+            std::string::npos);
 }
 
 // Issue 5: "The watertight triangle test and robust traversal leak no ray

@@ -31,7 +31,7 @@ Fields row(const Fields& changes = {}) {
               {"ratio_to_embree", "1"}, {"hit_rate", "0.5"},    {"agree_hit", "1"},        {"agree_prim", "1"},
               {"prim_ties", "0"},     {"t_relerr_max", "0"},    {"t_relerr_p999", "0"},    {"disagreements", "0"},
               {"leaks", ""},          {"sah_cost", ""},         {"reference", "embree"},   {"ratio_to_reference", "1"},
-              {"plugin", ""}};
+              {"plugin", ""},         {"representation", "triangles"}};
   for (const auto& [k, v] : changes) r[k] = v;
   return r;
 }
@@ -133,7 +133,7 @@ TEST(ReadResultsFile, ASpreadsheetsByteOrderMarkAndCrlfLineEndsRead) {
   const ResultsFile f = read_results_file(dir.write("excel.csv", text));
   ASSERT_EQ(f.rows.size(), 2u);
   EXPECT_EQ(f.rows[0].at("scene"), "terrain");
-  EXPECT_EQ(f.rows[1].at("plugin"), "");  // the last column, without the '\r'
+  EXPECT_EQ(f.rows[1].at("representation"), "triangles");  // the last column, without the '\r'
   EXPECT_EQ(f.lines, (std::vector<std::size_t>{2, 3}));
 }
 

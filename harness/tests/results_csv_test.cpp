@@ -76,6 +76,33 @@ TEST(ResultsCsv, ColumnsAreAppendedAfterThoseOfOlderFiles) {
   EXPECT_EQ(c[26], "reference");
   EXPECT_EQ(c[27], "ratio_to_reference");
   EXPECT_EQ(c[28], "plugin");
+  ASSERT_GE(c.size(), 30u);
+  EXPECT_EQ(c[29], "representation");
+}
+
+TEST(ResultsCsv, TheRepresentationRoundTripsAndIsEmptyInOlderFiles) {
+  TempDir dir;
+  ResultRow analytic, stand_in;
+  analytic.scene = "balls";
+  analytic.representation = "analytic";
+  stand_in.scene = "balls@uv16x8";
+  stand_in.representation = "uv16x8";
+  write_results_csv(dir.file("r.csv"), {analytic, stand_in});
+  const auto rows = read_results_csv(dir.file("r.csv"));
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].at("representation"), "analytic");
+  EXPECT_EQ(rows[1].at("representation"), "uv16x8");
+  EXPECT_EQ(rows[1].at("scene"), "balls@uv16x8");
+  // A file of the schema before it (up to plugin) reads, the column empty.
+  std::string header, line;
+  for (std::size_t i = 0; i + 1 < result_columns().size(); ++i) {
+    header += (i ? "," : "") + result_columns()[i];
+    line += (i ? "," : "") + std::string(i == 0 ? "old" : i == 2 ? "primary" : i == 5 ? "embree" : i == 6 ? "1" : "");
+  }
+  const auto old = read_results_csv(dir.write("old.csv", header + "\n" + line + "\n"));
+  ASSERT_EQ(old.size(), 1u);
+  EXPECT_EQ(old[0].at("representation"), "");
+  EXPECT_EQ(old[0].at("scene"), "old");
 }
 
 TEST(ResultsCsv, SahCostReferenceAndPluginRoundTrip) {

@@ -163,6 +163,56 @@ TEST(Suite, MistakesNameTheFileAndTheKey) {
   }
 }
 
+// Issue 31: the tessellation study's resolutions, for every scene or one.
+TEST(Suite, TessellateIsReadFromTheDefaultsAndEachSceneAndSweepCopiesKeepIt) {
+  TempDir dir;
+  const Suite suite = load_suite(dir.write("t.toml", R"(
+[defaults]
+tessellate = ["8x4", "32x16"]
+[[scene]]
+name = "inherits"
+path = "proc:sphere"
+[[scene]]
+name = "own"
+path = "proc:sphere"
+tessellate = ["256x128"]
+[[scene]]
+name = "none"
+path = "proc:sphere"
+tessellate = []
+[[scene]]
+name = "swept"
+path = "proc:sphere"
+tessellate = ["16x8"]
+sweep = { scales = [1.0, 2.0] }
+)"));
+  EXPECT_EQ(suite.settings.tessellate, (std::vector<Tessellation>{{8, 4}, {32, 16}}));
+  EXPECT_FALSE(suite.find("inherits")->tessellate.has_value()) << "unset: the defaults apply";
+  EXPECT_EQ(*suite.find("own")->tessellate, (std::vector<Tessellation>{{256, 128}}));
+  EXPECT_TRUE(suite.find("none")->tessellate->empty());
+  EXPECT_EQ(*suite.find("swept@s2")->tessellate, (std::vector<Tessellation>{{16, 8}}));
+  EXPECT_TRUE(load_suite(dir.write("d.toml", "[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\n")).settings.tessellate.empty())
+      << "no stand-ins unless asked for";
+  const struct {
+    const char* text;
+    const char* problem;
+  } cases[] = {
+      {"[defaults]\ntessellate = [\"16\"]\n[[scene]]\nname = \"a\"\npath = \"p\"\n",
+       "'defaults.tessellate': must be SxR"},
+      {"[defaults]\ntessellate = \"8x4\"\n[[scene]]\nname = \"a\"\npath = \"p\"\n",
+       "'defaults.tessellate': expected an array of strings"},
+      {"[[scene]]\nname = \"a\"\npath = \"p\"\ntessellate = [\"8x4\", \"2x2\"]\n", "'scene[0].tessellate': must be SxR"},
+      {"[[scene]]\nname = \"a\"\npath = \"p\"\ntessellate = [\"8x4\", \"8x4\"]\n",
+       "'scene[0].tessellate': 8x4 is given twice"},
+  };
+  int i = 0;
+  for (const auto& c : cases) {
+    const auto path = dir.write("bad" + std::to_string(i++) + ".toml", c.text);
+    const std::string error = error_of(path);
+    EXPECT_NE(error.find(path + ": " + c.problem), std::string::npos) << "expected '" << c.problem << "' in: " << error;
+  }
+}
+
 // Issue 28: a manifest's numbers were not validated as the command line's
 // were (threads = 3000000000 wrapped to a negative count, min_time = 0 or NaN
 // aborted inside Google Benchmark, warmup = inf warmed up forever), and the

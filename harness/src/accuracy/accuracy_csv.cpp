@@ -29,8 +29,14 @@ const std::vector<Column>& schema() {
       {"ambiguous", &R::ambiguous},   {"false_miss", &R::false_miss}, {"false_hit", &R::false_hit},
       {"wrong_prim", &R::wrong_prim}, {"self_hits", &R::self_hits}, {"ulp_p50", &R::ulp_p50},
       {"ulp_p99", &R::ulp_p99},       {"ulp_max", &R::ulp_max},     {"mrays_s", &R::mrays_s},
-      {"mrays_s_min", &R::mrays_s_min}, {"mrays_s_max", &R::mrays_s_max}};
+      {"mrays_s_min", &R::mrays_s_min}, {"mrays_s_max", &R::mrays_s_max}, {"t_relerr_p99", &R::t_relerr_p99},
+      {"t_relerr_max", &R::t_relerr_max}, {"representation", &R::representation}};
   return columns;
+}
+
+// Appended after files were published; older files lack them.
+bool is_optional_column(const std::string& c) {
+  return c == "t_relerr_p99" || c == "t_relerr_max" || c == "representation";
 }
 
 }  // namespace
@@ -69,8 +75,13 @@ void write_accuracy_csv(const std::string& path, const std::vector<AccuracyRow>&
 std::vector<AccuracyRow> read_accuracy_csv(const std::string& path) {
   std::vector<AccuracyRow> rows;
   std::size_t line = 1;
-  for (const auto& m : read_csv_rows(path, accuracy_columns())) {
+  std::vector<std::string> required;
+  for (const std::string& c : accuracy_columns())
+    if (!is_optional_column(c)) required.push_back(c);
+  for (auto m : read_csv_rows(path, required)) {
     ++line;
+    for (const std::string& c : accuracy_columns())
+      if (is_optional_column(c)) m.emplace(c, "");  // keeps the file's value when it has the column
     const auto number = [&](const char* column) {
       const std::string& f = m.at(column);
       if (f.empty()) return static_cast<double>(NAN);

@@ -35,6 +35,13 @@ struct AccuracyRow {
   double ulp_p50 = NAN, ulp_p99 = NAN, ulp_max = NAN;
   // Throughput of this backend on these rays (median of repetitions, one thread).
   double mrays_s = NAN, mrays_s_min = NAN, mrays_s_max = NAN;
+  // |t - t_exact| / t_exact over the same rays as the ulps: the depth error
+  // in relative terms (a tessellated sphere's is far above rounding).
+  double t_relerr_p99 = NAN, t_relerr_max = NAN;
+  // As in the results CSV (results_csv.h): triangles, analytic or
+  // uv<S>x<R>, the stand-in of the scene before the '@' judged against that
+  // scene's referee. Empty in files older than the column.
+  std::string representation;
 
   double error_rate() const { return false_miss + false_hit + wrong_prim; }
 };
@@ -43,7 +50,9 @@ const std::vector<std::string>& accuracy_columns();
 
 // Writes header and rows atomically; NaN is an empty field.
 void write_accuracy_csv(const std::string& path, const std::vector<AccuracyRow>& rows);
-// Throws InputError on a missing column, a ragged line or a bad number.
+// Throws InputError on a missing column, a ragged line or a bad number. The
+// columns appended with issue 31 (t_relerr_p99, t_relerr_max,
+// representation) may be missing, as in older files: they read as empty.
 std::vector<AccuracyRow> read_accuracy_csv(const std::string& path);
 
 }  // namespace raybench

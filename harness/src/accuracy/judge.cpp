@@ -42,7 +42,7 @@ void judge_hits(const Referee& referee, std::span<const Ray> rays, std::span<con
                 std::span<const Hit> hits, std::span<const std::int32_t> sources, AccuracyRow& row) {
   count_truth(rays, truth, row);
   std::size_t false_miss = 0, false_hit = 0, wrong_prim = 0, self_hits = 0;
-  std::vector<double> ulps;
+  std::vector<double> ulps, relerrs;
   for (std::size_t i = 0; i < rays.size(); ++i) {
     const RefereeVerdict& v = truth[i];
     const Hit& h = hits[i];
@@ -52,7 +52,10 @@ void judge_hits(const Referee& referee, std::span<const Ray> rays, std::span<con
     if (v.hit() && h.hit()) {
       accepted = referee.accepts(rays[i], v, h.prim);
       if (!accepted && !v.ambiguous) ++wrong_prim;
-      if (accepted || v.ambiguous) ulps.push_back(ulp_error(h.t, v.t));
+      if (accepted || v.ambiguous) {
+        ulps.push_back(ulp_error(h.t, v.t));
+        relerrs.push_back(v.t > 0.0 ? std::fabs(static_cast<double>(h.t) - v.t) / v.t : 0.0);
+      }
     }
     if (!sources.empty() && h.hit() && h.prim == sources[i] && !accepted) ++self_hits;
   }
@@ -63,6 +66,9 @@ void judge_hits(const Referee& referee, std::span<const Ray> rays, std::span<con
   row.ulp_p50 = nearest_rank_percentile(ulps, 0.5);
   row.ulp_p99 = nearest_rank_percentile(ulps, 0.99);
   row.ulp_max = ulps.empty() ? std::numeric_limits<double>::quiet_NaN() : *std::max_element(ulps.begin(), ulps.end());
+  row.t_relerr_p99 = nearest_rank_percentile(relerrs, 0.99);
+  row.t_relerr_max =
+      relerrs.empty() ? std::numeric_limits<double>::quiet_NaN() : *std::max_element(relerrs.begin(), relerrs.end());
 }
 
 void judge_occlusion(std::span<const Ray> rays, std::span<const RefereeVerdict> truth,

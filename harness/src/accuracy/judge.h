@@ -14,7 +14,7 @@ namespace raybench {
 // Closest-hit answers. `sources` (empty, or one per ray) names the triangle a
 // secondary ray starts from: hitting it again, where the referee does not
 // accept that hit, is a self-intersection. Fills the counting columns of
-// `row` (rays, invalid, truth_hits, ambiguous, false_*, wrong_prim, self_hits, ulp_*).
+// `row` (rays, invalid, truth_hits, ambiguous, false_*, wrong_prim, self_hits, ulp_*, t_relerr_*).
 void judge_hits(const Referee& referee, std::span<const Ray> rays, std::span<const RefereeVerdict> truth,
                 std::span<const Hit> hits, std::span<const std::int32_t> sources, AccuracyRow& row);
 

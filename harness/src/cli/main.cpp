@@ -30,6 +30,7 @@
 #include "rays/rayset.h"
 #include "rays/screening.h"
 #include "scene/scene.h"
+#include "scene/tessellate.h"
 #include "suite/scene_selection.h"
 #include "suite/settings_rules.h"
 #include "suite/suite.h"
@@ -158,7 +159,7 @@ int run(int argc, char** argv) {
   // raybench run
   RunOptions run_options;
   std::string suite_path = kDefaultSuite;
-  std::vector<std::string> run_raysets, run_backends, run_threads;
+  std::vector<std::string> run_raysets, run_backends, run_threads, run_tessellate;
   std::string run_rays, run_reps, run_build_reps, run_seed, run_min_time, run_warmup, run_reference;
   bool no_interleave = false, list_only = false;
   run_options.out_csv = kDefaultOut;
@@ -191,6 +192,13 @@ int run(int argc, char** argv) {
   run_cmd->add_option("--accuracy", run_options.accuracy_csv,
                       "Also judge every ray with the exact referee and write the accuracy CSV here "
                       "(e.g. results/accuracy.csv; see scripts/accuracy)");
+  run_cmd->add_option("--tessellate", run_tessellate,
+                      "The tessellation study: also trace each scene with analytic primitives as triangle stand-ins "
+                      "<scene>@uv<S>x<R>, spheres as UV spheres of S segments by R rings, boxes as 12 triangles, "
+                      "e.g. 8x4,32x16,256x128; with the scene's own rays, judged against its referee with --accuracy; "
+                      "'none' for no stand-in (default: the suite's tessellate)")
+      ->delimiter(',')
+      ->type_name("SxR");
 
   // raybench rays
   std::string rays_scene, rays_kind = "primary", rays_out, rays_suite = kDefaultSuite;
@@ -487,6 +495,13 @@ int run(int argc, char** argv) {
         s.reference = v;
         s.reference_given = "--reference";
       });
+    if (run_cmd->count("--tessellate")) {
+      const std::vector<Tessellation> list =
+          run_tessellate == std::vector<std::string>{"none"} ? std::vector<Tessellation>{}
+                                                              : parse_tessellations(run_tessellate, "--tessellate");
+      overrides.push_back([list](SuiteSettings& s) { s.tessellate = list; });
+      run_options.tessellate_from_command_line = true;
+    }
     check_named("--out", run_options.out_csv);
     if (run_options.rays_dir.empty()) throw InputError("--rays-dir", "must name a folder, got ''");
     check_outputs({output("--out", run_options.out_csv), metadata_of("--out", run_options.out_csv),

@@ -23,7 +23,8 @@ const std::vector<std::string>& result_columns() {
       "threads",      "build_ms",     "build_ms_min",    "build_ms_max",  "memory_bytes", "mrays_s",
       "mrays_s_min",  "mrays_s_max",  "reps",            "mrays_s_samples", "ratio_to_embree", "hit_rate",
       "agree_hit",    "agree_prim",   "prim_ties",       "t_relerr_max",  "t_relerr_p999", "disagreements",
-      "leaks",        "sah_cost",     "reference",       "ratio_to_reference", "plugin"};
+      "leaks",        "sah_cost",     "reference",       "ratio_to_reference", "plugin",
+      "representation"};
   return columns;
 }
 
@@ -31,7 +32,8 @@ namespace {
 
 // Appended after the first published schema; older files lack them.
 bool is_optional_column(const std::string& c) {
-  return c == "sah_cost" || c == "reference" || c == "ratio_to_reference" || c == "plugin";
+  return c == "sah_cost" || c == "reference" || c == "ratio_to_reference" || c == "plugin" ||
+         c == "representation";
 }
 
 }  // namespace
@@ -43,7 +45,7 @@ void write_results_csv(const std::string& path, const std::vector<ResultRow>& ro
     out << '\n';
     for (const ResultRow& r : rows) {
       const std::string samples = fmt::format("{:.6g}", fmt::join(r.mrays_s_samples, ";"));
-      out << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", text(r.scene),
+      out << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", text(r.scene),
                          r.triangles, text(r.rayset), r.query, r.rays, text(r.backend), r.threads, number(r.build_ms),
                          number(r.build_ms_min), number(r.build_ms_max), r.memory_bytes, number(r.mrays_s),
                          number(r.mrays_s_min), number(r.mrays_s_max), r.reps, samples,
@@ -51,7 +53,8 @@ void write_results_csv(const std::string& path, const std::vector<ResultRow>& ro
                          number(r.agree_hit), number(r.agree_prim), r.prim_ties, number(r.t_relerr_max),
                          number(r.t_relerr_p999), r.disagreements, r.leaks ? std::to_string(*r.leaks) : std::string(),
                          number(r.sah_cost), text(r.reference),
-                         r.ratio_to_reference > 0 ? number(r.ratio_to_reference) : std::string(), text(r.plugin));
+                         r.ratio_to_reference > 0 ? number(r.ratio_to_reference) : std::string(), text(r.plugin),
+                         text(r.representation));
     }
   });
 }

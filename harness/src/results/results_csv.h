@@ -41,6 +41,11 @@ struct ResultRow {
   // Plugins (--backend plugin:PATH.so): the name the plugin reports; empty
   // for built-in backends.
   std::string plugin;
+  // What the scene's primitives were traced as (issue 31): "triangles" (a
+  // scene without analytic primitives), "analytic" (spheres, boxes and
+  // oriented boxes as such), or "uv<S>x<R>" (the scene's triangle stand-in,
+  // scene/tessellate.h, scene "<scene>@uv<S>x<R>"). Empty in older files.
+  std::string representation;
 };
 
 // Column names in file order. Columns are only ever appended, so a reader
@@ -53,7 +58,7 @@ void write_results_csv(const std::string& path, const std::vector<ResultRow>& ro
 
 // Reads a results CSV into column -> value maps (tests and tools); throws
 // InputError when the header lacks a schema column. Columns appended after
-// the first schema (sah_cost) may be missing, as in files older than them:
+// the first schema (sah_cost ... representation) may be missing, as in files older than them:
 // they read as the empty field, "not applicable". `lines`, when given,
 // receives each row's line number (see read_csv_rows).
 std::vector<std::map<std::string, std::string>> read_results_csv(const std::string& path,

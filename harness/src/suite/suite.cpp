@@ -89,6 +89,13 @@ class Reader {
     return out;
   }
 
+  // `tessellate = ["8x4", "32x16"]` (scene/tessellate.h) when the table has
+  // it; `where` is "defaults." or "scene[i].".
+  std::optional<std::vector<Tessellation>> tessellations(const toml::table& table, const std::string& where) const {
+    if (!table.get("tessellate")) return std::nullopt;
+    return parse_tessellations(strings(table, where, "tessellate", {}), fmt::format("{}: '{}tessellate'", path_, where));
+  }
+
   // A point (camera position and target, light, ball centre): finite, and
   // within the coordinates every backend can trace (kLargestTraceableCoordinate,
   // Embree's range); rays from or towards a point beyond it are all misses.
@@ -297,7 +304,7 @@ Suite load_suite(const std::string& path) {
     const toml::table* t = d->as_table();
     if (!t) r.fail("defaults", "expected a table");
     r.check_keys(*t, "defaults", {"rays", "raysets", "backends", "threads", "repetitions", "build_repetitions", "seed",
-                                  "min_time", "warmup", "reference"});
+                                  "min_time", "warmup", "reference", "tessellate"});
     r.setting(*t, "defaults.", "rays", rays_setting, s.rays);
     s.raysets = r.strings(*t, "defaults.", "raysets", s.raysets);
     for (const std::string& k : s.raysets) {
@@ -330,6 +337,7 @@ Suite load_suite(const std::string& path) {
       s.reference = reference_setting(given);
       s.reference_given = given.where;
     }
+    s.tessellate = r.tessellations(*t, "defaults.").value_or(s.tessellate);
   }
   const fs::path base = fs::path(path).parent_path();
   if (const toml::node* scenes = root.get("scene")) {
@@ -341,7 +349,8 @@ Suite load_suite(const std::string& path) {
       const toml::table* t = e.as_table();
       if (!t) r.fail(key, "expected a table");
       r.check_keys(*t, key, {"name", "path", "spheres", "boxes", "obbs", "optional", "camera", "light", "inside",
-                             "raysets", "note", "scale", "offset", "sweep"});
+                             "raysets", "note", "scale", "offset", "sweep",
+                             "tessellate"});
       SuiteScene scene;
       scene.name = r.get<std::string>(*t, key + ".", "name", "");
       scene.path = r.get<std::string>(*t, key + ".", "path", "");
@@ -383,6 +392,7 @@ Suite load_suite(const std::string& path) {
           r.fail(key + ".raysets", e.what());
         }
       }
+      scene.tessellate = r.tessellations(*t, key + ".");
       scene.scale = r.get<double>(*t, key + ".", "scale", 1.0);
       if (!(scene.scale > 0.0 && std::isfinite(scene.scale))) r.fail(key + ".scale", "must be a positive number");
       if (const toml::node* o = t->get("offset")) scene.offset = r.vec3d(*o, key + ".offset");

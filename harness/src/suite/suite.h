@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rays/rayset.h"
+#include "scene/tessellate.h"
 
 namespace raybench {
 
@@ -26,6 +27,9 @@ struct SuiteScene {
   std::optional<Vec3f> light;
   std::optional<InsideBall> inside;  // a closed mesh's inner ball: enables the must-hit ray sets
   std::vector<std::string> raysets;  // this scene's ray sets; empty: the suite's defaults
+  // This scene's tessellation study (scene/tessellate.h): the resolutions of
+  // its triangle stand-ins; unset: the suite's defaults; empty: none.
+  std::optional<std::vector<Tessellation>> tessellate;
   // Every vertex v becomes float(scale * v + offset) after loading, as do
   // sphere and box centres and box corners; radii and half extents become
   // float(scale * r); OBB axes are kept. Camera, light and inside ball
@@ -64,6 +68,9 @@ struct SuiteSettings {
   // given, for messages ("--reference", or "FILE: 'defaults.reference'").
   std::string reference;
   std::string reference_given;
+  // The resolutions every scene with analytic primitives is also traced at
+  // as a triangle stand-in ([defaults] tessellate, --tessellate); empty: none.
+  std::vector<Tessellation> tessellate;
 };
 
 struct Suite {

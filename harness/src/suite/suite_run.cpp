@@ -31,8 +31,10 @@
 #include "referee/referee.h"
 #include "scene/random.h"
 #include "scene/scene.h"
+#include "scene/tessellate.h"
 #include "suite/results_table.h"
 #include "suite/scene_selection.h"
+#include "suite/settings_rules.h"
 #include "measure/trace.h"
 
 namespace raybench {
@@ -96,19 +98,21 @@ std::uint64_t round_seed(std::uint64_t seed, const std::string& scene) {
   return hash_string(scene.c_str()) ^ (seed * 0x9e3779b97f4a7c15ull);
 }
 
-// One scene, scene `index` of `count`: its ray sets (made or reused) and
-// screened, the referee's verdicts (accuracy runs), every backend that can
-// model the scene built (the others skipped with a note), agreement with
-// Embree, the timing of every case in rounds, and the ratios to the timing
-// `reference` ("" for none) and to embree. No rows when no ray set applies.
-SceneResults measure_scene(const RunOptions& options, const std::string& reference, const LoadedScene& loaded,
-                           std::size_t index, std::size_t count) {
+// What every representation of a scene is traced with: its ray sets (made
+// or reused, and screened) and, in accuracy runs, the referee's verdicts.
+struct SceneRays {
+  std::vector<RaySet> raysets;
+  std::unique_ptr<Referee> referee;  // accuracy runs: judges the scene as loaded (its analytic primitives)
+};
+
+// Scene `index` of `count`: its ray sets and the referee's verdicts on them.
+SceneRays make_scene_rays(const RunOptions& options, const LoadedScene& loaded, std::size_t index, std::size_t count) {
   const Scene& scene = loaded.scene;
   const SuiteScene* entry = loaded.choice.entry;
   const SuiteSettings& settings = options.settings;
-  SceneResults results;
+  SceneRays out;
+  std::vector<RaySet>& raysets = out.raysets;
   progress(fmt::format("[{}/{}] {}: ray sets", index + 1, count, scene.name));
-  std::vector<RaySet> raysets;
   {
     const RayGenerator generator(scene);
     const std::vector<std::string>& names =
@@ -132,21 +136,36 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
       raysets.push_back(std::move(set));
     }
   }
-  std::unique_ptr<Referee> referee;
   if (!options.accuracy_csv.empty() && !raysets.empty()) {
     const auto start = std::chrono::steady_clock::now();
-    referee = std::make_unique<Referee>(scene);
+    out.referee = std::make_unique<Referee>(scene);
     for (RaySet& rs : raysets) {
       rs.truth.resize(rs.rays.size());
-      referee->judge(rs.rays, rs.truth);
+      out.referee->judge(rs.rays, rs.truth);
     }
     progress(fmt::format("  referee: judged every ray exactly in {:.0f} ms",
                          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()));
   }
-  if (raysets.empty()) {
-    progress(fmt::format("[{}/{}] {}: no ray set applies, scene skipped", index + 1, count, scene.name));
-    return results;
-  }
+  return out;
+}
+
+// One representation of scene `index` of `count`: the scene as loaded
+// (stand_in null), or its triangle stand-in traced with the same rays and
+// judged by the same referee, its hits read as hits on the primitives they
+// stand for. Every backend built, agreement with Embree (on the same
+// representation), the timing of every case in rounds, and the ratios to the
+// timing `reference` ("" for none) and to embree.
+SceneResults measure_scene(const RunOptions& options, const std::string& reference, const LoadedScene& loaded,
+                           const SceneRays& scene_rays, const StandIn* stand_in, std::size_t index,
+                           std::size_t count) {
+  const Scene& scene = stand_in ? stand_in->scene : loaded.scene;
+  const SuiteScene* entry = loaded.choice.entry;
+  const SuiteSettings& settings = options.settings;
+  const std::vector<RaySet>& raysets = scene_rays.raysets;
+  const Referee* referee = scene_rays.referee.get();
+  const std::string representation =
+      stand_in ? stand_in->tessellation.name() : scene.has_analytic() ? "analytic" : "triangles";
+  SceneResults results;
 
   // Backends lacking a primitive type of the scene are skipped for it, with
   // a note: never given a scene they would trace wrongly (a plugin would see
@@ -181,7 +200,7 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
     }
     baseline.reset();
     // What the camera sees, once per scene: Embree's primary hits.
-    for (std::size_t r = 0; r < raysets.size() && !results.camera; ++r) {
+    for (std::size_t r = 0; r < raysets.size() && !results.camera && !stand_in; ++r) {
       if (raysets[r].kind != RaySetKind::kPrimary || ref_hits[r].empty()) continue;
       const auto hit = std::count_if(ref_hits[r].begin(), ref_hits[r].end(), [](const Hit& h) { return h.hit(); });
       results.camera = CameraCoverage{scene.name, static_cast<double>(hit) / static_cast<double>(ref_hits[r].size()),
@@ -220,6 +239,7 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
         row.memory_bytes = backend->memory_bytes();
         row.sah_cost = backend->sah_cost();
         row.plugin = backend->plugin_name();
+        row.representation = representation;
         Agreement a;
         // Accuracy rows are single-run, single thread count: the first one.
         std::optional<AccuracyRow> accuracy;
@@ -236,6 +256,7 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
           accuracy->query = row.query;
           accuracy->backend = backend_name;
           accuracy->accuracy_class = backend->accuracy_class();
+          accuracy->representation = representation;
         }
         // Untimed: the answers that count, screened rays forced to misses;
         // the referee judges them against the rays as stored.
@@ -243,7 +264,9 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
           const std::vector<Hit> hits = executor.answers(*backend, rs.screened);
           require_valid_hits(*backend, hits, scene.primitive_count(), scene.name + "/" + row.rayset);
           a = compare_hits(hits, ref_hits[r], rs.screened.rays, scene.primitives());
-          if (accuracy) judge_hits(*referee, rs.rays, rs.truth, hits, rs.sources, *accuracy);
+          if (accuracy)
+            judge_hits(*referee, rs.rays, rs.truth, stand_in ? analytic_hits(hits, *stand_in) : hits, rs.sources,
+                       *accuracy);
         } else {
           const std::vector<std::uint8_t> occ = executor.occlusion_answers(*backend, rs.screened);
           require_valid_occlusion(*backend, occ, scene.name + "/" + row.rayset);
@@ -342,6 +365,42 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
   return results;
 }
 
+// The resolutions scene `loaded` is also traced at as a triangle stand-in
+// (scene/tessellate.h): --tessellate's, else the scene's own `tessellate`,
+// else the suite's defaults; none for a scene without analytic primitives.
+// A scene without spheres is the same stand-in at every resolution (its
+// boxes are 12 triangles each): traced once, at the first.
+std::vector<Tessellation> stand_ins_of(const RunOptions& options, const LoadedScene& loaded) {
+  const SuiteScene* entry = loaded.choice.entry;
+  std::vector<Tessellation> list = options.tessellate_from_command_line || !entry || !entry->tessellate
+                                       ? options.settings.tessellate
+                                       : *entry->tessellate;
+  if (!loaded.scene.has_analytic()) return {};
+  if (loaded.scene.spheres.empty() && list.size() > 1) list.resize(1);
+  return list;
+}
+
+// Scene `index` of `count`, then each of its stand-ins (stand_ins_of), one
+// at a time, all with the scene's rays: the scene's rows first.
+SceneResults measure_representations(const RunOptions& options, const std::string& reference,
+                                      const LoadedScene& loaded, std::size_t index, std::size_t count) {
+  const SceneRays rays = make_scene_rays(options, loaded, index, count);
+  if (rays.raysets.empty()) {
+    progress(fmt::format("[{}/{}] {}: no ray set applies, scene skipped", index + 1, count, loaded.scene.name));
+    return {};
+  }
+  SceneResults results = measure_scene(options, reference, loaded, rays, nullptr, index, count);
+  for (const Tessellation& t : stand_ins_of(options, loaded)) {
+    const StandIn stand_in = tessellate(loaded.scene, t);
+    progress(fmt::format("[{}/{}] {}: {} triangles standing for {}, traced with its rays", index + 1, count,
+                         stand_in.scene.name, stand_in.scene.triangles.size(), loaded.scene.name));
+    SceneResults more = measure_scene(options, reference, loaded, rays, &stand_in, index, count);
+    results.rows.insert(results.rows.end(), more.rows.begin(), more.rows.end());
+    results.accuracy.insert(results.accuracy.end(), more.accuracy.begin(), more.accuracy.end());
+  }
+  return results;
+}
+
 std::string partial_results_note(const RunOptions& options, std::size_t finished, std::size_t total) {
   return fmt::format("partial results ({} of {} scenes) in {}{}", finished, total, options.out_csv,
                      options.accuracy_csv.empty() ? "" : " and " + options.accuracy_csv);
@@ -402,7 +461,17 @@ std::string timing_reference(const SuiteSettings& settings) {
   return settings.reference;
 }
 
-RunResults run_suite(const RunOptions& options) {
+namespace {
+
+// What a run knows before it loads a scene: its timing reference and the
+// provenance of its backends (metadata). Validates everything cheap first,
+// before minutes are spent loading and measuring.
+struct RunChecks {
+  std::string reference;
+  Metadata provenance;
+};
+
+RunChecks check_run(const RunOptions& options) {
   const SuiteSettings& settings = options.settings;
   // Validate everything cheap before spending minutes.
   for (const std::string& k : settings.raysets) parse_rayset_kind(k);
@@ -421,6 +490,16 @@ RunResults run_suite(const RunOptions& options) {
   if (settings.repetitions < 1) throw InputError("", "--reps must be at least 1");
   check_writable(options.out_csv);
   if (!options.accuracy_csv.empty()) check_writable(options.accuracy_csv);
+  return {reference, provenance};
+}
+
+RunResults run_loaded_scenes(const RunOptions& options, const RunChecks& checks,
+                             const std::vector<LoadedScene>& scenes);
+
+}  // namespace
+
+RunResults run_suite(const RunOptions& options) {
+  const RunChecks checks = check_run(options);
   std::vector<SceneChoice> chosen = choose_scenes(options.scenes, options.suite);
   if (options.scenes.empty()) {
     for (const SuiteScene& s : options.suite.scenes) {
@@ -440,6 +519,35 @@ RunResults run_suite(const RunOptions& options) {
                          s.skipped_points + s.skipped_lines
                              ? fmt::format(" ({} points and {} lines skipped)", s.skipped_points, s.skipped_lines)
                              : ""));
+  }
+  return run_loaded_scenes(options, checks, scenes);
+}
+
+RunResults run_scenes(const RunOptions& options, std::vector<Scene> made) {
+  const RunChecks checks = check_run(options);
+  std::vector<LoadedScene> scenes;
+  for (Scene& scene : made) {
+    if (const std::string problem = scene_name_problem(scene.name); !problem.empty())
+      throw InputError(fmt::format("scene '{}'", printable(scene.name)), problem);
+    const SceneChoice choice{scene.name, scene.name, nullptr, scene.source};
+    scenes.push_back({choice, std::move(scene)});
+  }
+  return run_loaded_scenes(options, checks, scenes);
+}
+
+namespace {
+
+RunResults run_loaded_scenes(const RunOptions& options, const RunChecks& checks,
+                             const std::vector<LoadedScene>& scenes) {
+  const SuiteSettings& settings = options.settings;
+  const std::string& reference = checks.reference;
+  const Metadata& provenance = checks.provenance;
+  // A stand-in too large for int32 prim ids fails now, not after the scenes before it.
+  for (const LoadedScene& loaded : scenes) {
+    for (const Tessellation& t : stand_ins_of(options, loaded)) check_stand_in_size(loaded.scene, t);
+    if (loaded.scene.has_analytic() && loaded.scene.spheres.empty() && stand_ins_of(options, loaded).size() == 1)
+      progress(fmt::format("{}: no spheres, so one stand-in (boxes are 12 triangles at every resolution)",
+                           loaded.scene.name));
   }
 
   std::vector<std::string> scene_names;
@@ -461,6 +569,9 @@ RunResults run_suite(const RunOptions& options) {
       {"reference_backend", reference},
       {"agreement_backend", kAgreementBackend},
   };
+  std::vector<std::string> tessellate;
+  for (const Tessellation& t : settings.tessellate) tessellate.push_back(t.spec());
+  run_description.emplace_back("tessellate", fmt::format("{}", fmt::join(tessellate, ",")));
   run_description.insert(run_description.end(), provenance.begin(), provenance.end());
 
   // Rounds are ordered by run_rounds itself, reproducibly: Google Benchmark's
@@ -473,7 +584,7 @@ RunResults run_suite(const RunOptions& options) {
   set_interrupt_message(fmt::format("no scene had finished; nothing written to {}", options.out_csv));
   try {
     for (std::size_t si = 0; si < scenes.size(); ++si) {
-      SceneResults scene = measure_scene(options, reference, scenes[si], si, scenes.size());
+      SceneResults scene = measure_representations(options, reference, scenes[si], si, scenes.size());
       rows.insert(rows.end(), scene.rows.begin(), scene.rows.end());
       accuracy_rows.insert(accuracy_rows.end(), scene.accuracy.begin(), scene.accuracy.end());
       if (scene.camera) results.cameras.push_back(*scene.camera);
@@ -495,5 +606,7 @@ RunResults run_suite(const RunOptions& options) {
     progress(fmt::format("accuracy: {} ({} rows)", options.accuracy_csv, accuracy_rows.size()));
   return results;
 }
+
+}  // namespace
 
 }  // namespace raybench

@@ -21,6 +21,7 @@ struct RunOptions {
   std::string out_csv;
   std::string rays_dir;              // where ray sets are stored and reused
   bool raysets_from_command_line = false;  // settings.raysets then override each scene's own list
+  bool tessellate_from_command_line = false;  // settings.tessellate then overrides each scene's own list
   bool interleave = true;            // each timing round in its own random order (false: the cases' order)
   std::string command_line;          // recorded in the metadata
   // When set, every ray is also judged by the exact referee and the accuracy
@@ -74,5 +75,12 @@ struct RunResults {
 // the tables (results_table.h) are the caller's to print. Throws InputError
 // on bad input, before any benchmark runs where possible.
 RunResults run_suite(const RunOptions& options);
+
+// Runs scenes made in memory as run_suite runs a suite's scenes, with the
+// settings' ray sets and tessellations (no manifest entry: no camera, light
+// or inside ball of their own); options.scenes and the suite's scenes are
+// not consulted. For callers that make their scenes themselves (tests).
+// Throws InputError for a scene name scene_name_problem refuses.
+RunResults run_scenes(const RunOptions& options, std::vector<Scene> scenes);
 
 }  // namespace raybench
