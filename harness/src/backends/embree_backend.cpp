@@ -219,6 +219,7 @@ class EmbreeBackend final : public Backend {
     rtcSetSceneBuildQuality(scene_, options_.quality);
     rtcSetSceneFlags(scene_, options_.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     const PrimitiveSpans prims = scene.primitives();
+    analytic_ = prims.has_analytic();
     first_id_[kTriangleGeometry] = 0;
     first_id_[kSphereGeometry] = static_cast<std::uint32_t>(prims.first_sphere());
     first_id_[kBoxGeometry] = static_cast<std::uint32_t>(prims.first_box());
@@ -240,23 +241,11 @@ class EmbreeBackend final : public Backend {
 
   std::size_t memory_bytes() const override { return memory_; }
 
+  // A triangle-only scene takes the loop without the id mapping, so that its
+  // per-ray work is what it was before analytic primitives existed.
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-      hits[i] = Hit{};
-      if (!is_traceable(rays[i]) || has_empty_interval(rays[i])) continue;  // Debian's Embree asserts on NaN/Inf
-      RTCRayHit rh;
-      fill(rh.ray, rays[i]);
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(scene_, &context, &rh);
-      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
-      const bool triangle = rh.hit.geomID == kTriangleGeometry;
-      hits[i] = {rh.ray.tfar, static_cast<std::int32_t>(first_id_[rh.hit.geomID] + rh.hit.primID),
-                 triangle ? rh.hit.u : 0.0f, triangle ? rh.hit.v : 0.0f};
-    }
+    if (analytic_) intersect_rays<true>(rays, hits);
+    else intersect_rays<false>(rays, hits);
   }
 
   void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override {
@@ -274,6 +263,30 @@ class EmbreeBackend final : public Backend {
   }
 
  private:
+  template <bool Analytic>
+  void intersect_rays(std::span<const Ray> rays, std::span<Hit> hits) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      hits[i] = Hit{};
+      if (!is_traceable(rays[i]) || has_empty_interval(rays[i])) continue;  // Debian's Embree asserts on NaN/Inf
+      RTCRayHit rh;
+      fill(rh.ray, rays[i]);
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      rtcIntersect1(scene_, &context, &rh);
+      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+      if constexpr (Analytic) {
+        const bool triangle = rh.hit.geomID == kTriangleGeometry;
+        hits[i] = {rh.ray.tfar, static_cast<std::int32_t>(first_id_[rh.hit.geomID] + rh.hit.primID),
+                   triangle ? rh.hit.u : 0.0f, triangle ? rh.hit.v : 0.0f};
+      } else {
+        hits[i] = {rh.ray.tfar, static_cast<std::int32_t>(rh.hit.primID), rh.hit.u, rh.hit.v};
+      }
+    }
+  }
+
   // Commits `geometry` and attaches it to the scene under `id`.
   void attach(RTCGeometry geometry, GeometryId id) {
     rtcSetGeometryBuildQuality(geometry, options_.quality);
@@ -347,6 +360,7 @@ class EmbreeBackend final : public Backend {
   std::string last_error_;
   std::atomic<std::int64_t> allocated_{0};
   std::size_t memory_ = 0;
+  bool analytic_ = false;             // the scene has spheres, boxes or OBBs
   std::uint32_t first_id_[4] = {};   // the global prim id of each geometry's primID 0
   std::vector<BBox> boxes_;          // the user geometries' primitives
   std::vector<OrientedBox> obbs_;
