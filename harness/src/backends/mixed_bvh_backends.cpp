@@ -25,6 +25,15 @@ namespace {
 
 enum class OurBvhFamily { kBvh2, kBvh8, kBvh4 };
 
+// Analytic primitives enter the tree by their boxes, which only the binned
+// builder takes (build_bvh2_binned_sah over BBox): the others refuse in one line.
+void require_binned_builder(const std::string& backend, const Scene& scene, Bvh2Builder builder) {
+  if (builder != Bvh2Builder::kBinnedSah)
+    throw InputError("", fmt::format("backend '{}' cannot build scene '{}': its analytic primitives are built over "
+                                     "their boxes by the binned builder only; drop ':{}'",
+                                     backend, scene.name, to_string(builder)));
+}
+
 // bvh2 for scenes with analytic primitives.
 template <typename Test, typename BoxTest>
 class MixedBvh2Backend final : public Backend {
@@ -35,10 +44,7 @@ class MixedBvh2Backend final : public Backend {
   const std::string& name() const override { return name_; }
 
   void build(const Scene& scene) override {
-    if (builder_ != Bvh2Builder::kBinnedSah)
-      throw InputError("", fmt::format("backend '{}' cannot build scene '{}': its analytic primitives are built over "
-                                       "their boxes by the binned builder only; drop ':{}'",
-                                       name_, scene.name, to_string(builder_)));
+    require_binned_builder(name_, scene, builder_);
     bvh_ = {};  // the old tree freed first
     bvh_ = build_mixed_bvh2<Test>(scene.primitives(), options_, analytic_);
   }
@@ -76,10 +82,7 @@ class MixedWideBvhBackend final : public Backend {
   const std::string& name() const override { return name_; }
 
   void build(const Scene& scene) override {
-    if (builder_ != Bvh2Builder::kBinnedSah)
-      throw InputError("", fmt::format("backend '{}' cannot build scene '{}': its analytic primitives are built over "
-                                       "their boxes by the binned builder only; drop ':{}'",
-                                       name_, scene.name, to_string(builder_)));
+    require_binned_builder(name_, scene, builder_);
     bvh_ = {};  // the old tree freed first
     bvh_ = build_mixed_wide_bvh<W, Leaf>(scene.primitives(), reinsertion_passes_, analytic_);
   }
