@@ -259,6 +259,10 @@ std::uint64_t fingerprint(const std::vector<Ray>& rays) {
   return h;
 }
 
+// invalid-rays is not fingerprinted: its directions are normalised in float,
+// and how the compiler contracts that arithmetic moves them by an ulp between
+// the Release and the sanitized build (1,414 of 3,000 rays), so no single
+// fingerprint holds for both.
 TEST(RaySets, TriangleScenesKeepTheRaysOfGeneratorVersion3) {
   ASSERT_EQ(kRayGeneratorVersion, 3) << "a new version may change these fingerprints: record the new ones";
   const std::pair<const char*, std::uint64_t> terrain[] = {
@@ -271,7 +275,6 @@ TEST(RaySets, TriangleScenesKeepTheRaysOfGeneratorVersion3) {
       {"degenerate-triangles", 0x66a19b95ffe47f77u},
       {"axis-parallel-signed-zero", 0x51057869e6710ebdu},
       {"behind-origin", 0x510dff6bfcc0316au},
-      {"invalid-rays", 0x6bca4723d722fdeau},
       {"direction-scaling", 0x4f1f114e9d916e39u},
       {"bvh-conservative", 0x00ecdb0326f9ddebu},
       {"reintersection", 0xda51435dba3d8408u},
