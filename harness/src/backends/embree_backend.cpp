@@ -7,42 +7,14 @@
 // 3 oriented boxes. A hit's global prim id is the first id of its type plus
 // Embree's primID; analytic hits report u = v = 0 (prim/analytic_hit.h).
 // - Triangles: RTC_GEOMETRY_TYPE_TRIANGLE.
-// - Spheres: RTC_GEOMETRY_TYPE_SPHERE_POINT (FLOAT4 x y z r), Embree's own
-//   ray-sphere test (kernels/geometry/sphere_intersector.h in Embree 3.13.5).
-//   Its semantics, tested in harness/tests/embree_analytic_test.cpp:
-//   * a true sphere surface, hit at its first crossing in the interval; a
-//     ray starting inside hits the far side (the exit), as ours do;
-//   * the centre-ray distance comes from projecting the centre onto the ray
-//     (l = c0 - (c0.d / d.d) d, the form of Haines et al., Ray Tracing Gems
-//     ch. 7), and l^2 <= r^2 hits: a tangent ray hits (closed), and a far
-//     ray's hit/miss does not suffer the textbook discriminant's cancellation;
-//     1/(d.d) is Embree's rcp (an approximation refined by one Newton step),
-//     so t differs from ours in its last bits; the near root is projection
-//     - half chord, which cancels when the origin is close to the surface
-//     of a big sphere (t then right to some ulps of r, not of t: so is ours,
-//     whose |f|^2 - r^2 loses the same digits);
-//   * the interval is closed at tnear ([tnear, tfar]), ours is open: a ray
-//     starting exactly on the surface hits it at t ~ 0 in Embree (pointing
-//     in or out), where raybench's semantics say the exit (pointing in) or a
-//     miss (pointing out); the referee counts such rays as ambiguous
-//     (start_contact);
-//   * a negative radius makes the sphere invalid and Embree drops it
-//     silently; the radius is passed as |r|, the sphere every one of our
-//     tests sees (they use r^2), and scene files refuse negative radii.
-//   `embree:disc` models spheres as RTC_GEOMETRY_TYPE_DISC_POINT instead:
-//   a flat disc facing the ray through the centre, hit at the centre's
-//   depth (t = c0.d / d.d) wherever the sphere's silhouette is hit, and
-//   missed by a ray starting within the radius of the centre (Embree's
-//   EMBREE_DISC_POINT_SELF_INTERSECTION_AVOIDANCE, on in Debian's build):
-//   Embree's cheapest stand-in for spheres, for comparison, wrong in t by up
-//   to r and wrong for every ray from inside.
-// - Boxes and oriented boxes: RTC_GEOMETRY_TYPE_USER, with bounds, intersect
-//   and occluded callbacks that run our scalar scene-level tests
-//   (analytic_hit.h: Slab for boxes, Obb for oriented boxes), so their
-//   answers are our kernels' behind Embree's BVH over the bounds (widened:
-//   see user_bounds; RTC_SCENE_FLAG_ROBUST does not reach user geometry);
-//   the cost of a callback per candidate is part of what this backend
-//   measures.
+// - Spheres: RTC_GEOMETRY_TYPE_SPHERE_POINT (FLOAT4 x y z |r|: Embree drops
+//   a negative radius), Embree's own test; `embree:disc` uses DISC_POINT.
+// - Boxes and oriented boxes: RTC_GEOMETRY_TYPE_USER, whose callbacks run
+//   our scalar surface tests (analytic_hit.h: Slab, Obb) behind Embree's BVH
+//   over widened bounds (user_bounds); their cost is part of what is measured.
+// Embree's sphere and disc semantics as embree_analytic_test.cpp pins them
+// (closed at tnear, tangent hits, the near root's cancellation):
+// docs/backends.md, "Analytic primitives in Embree".
 #include <algorithm>
 #include <atomic>
 #include <cmath>
