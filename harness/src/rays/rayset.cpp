@@ -23,7 +23,6 @@
 #include "raybench/bvh/bvh2_traverse.h"
 #include "raybench/math/offset_ray.h"
 #include "raybench/prim/aabb_slab.h"
-#include "raybench/prim/analytic_hit.h"
 #include "raybench/prim/obb_eigen.h"
 #include "raybench/prim/sphere_precise.h"
 
@@ -127,53 +126,20 @@ RaySetKind parse_rayset_kind(const std::string& name) {
 Query query_of(RaySetKind kind) { return kind == RaySetKind::kShadow ? Query::kOccluded : Query::kIntersect; }
 
 RayGenerator::RayGenerator(const Scene& scene) : scene_(scene), bounds_(scene.bounds()) {
-  if (!scene.has_analytic()) {
-    bvh_ = build_bvh2_binned_sah(scene.triangles);
-    prepared_.reserve(bvh_.prim_ids.size());
-    for (std::uint32_t id : bvh_.prim_ids) prepared_.push_back(MollerTrumbore::prepare(scene.triangles[id]));
+  if (scene.has_analytic()) {
+    // Our mixed BVH2 (bvh/mixed_bvh2.h) with the fixed surface tests:
+    // SpherePrecise, Slab, Obb beside Möller–Trumbore.
+    mixed_ = build_mixed_bvh2<MollerTrumbore>(scene.primitives());
     return;
   }
-  const PrimitiveSpans prims = scene.primitives();
-  std::vector<BBox> bounds(prims.size());
-  for (std::size_t id = 0; id < bounds.size(); ++id) bounds[id] = prims.bounds(id);
-  bvh_ = build_bvh2_binned_sah(std::span<const BBox>(bounds));
-  prepared_.resize(bvh_.prim_ids.size());
-  for (std::size_t i = 0; i < bvh_.prim_ids.size(); ++i)
-    if (bvh_.prim_ids[i] < scene.triangles.size()) prepared_[i] = MollerTrumbore::prepare(scene.triangles[bvh_.prim_ids[i]]);
+  bvh_ = build_bvh2_binned_sah(scene.triangles);
+  prepared_.reserve(bvh_.prim_ids.size());
+  for (std::uint32_t id : bvh_.prim_ids) prepared_.push_back(MollerTrumbore::prepare(scene.triangles[id]));
 }
 
 Hit RayGenerator::closest_hit(const Ray& ray) const {
-  if (!scene_.has_analytic()) return intersect_bvh2<MollerTrumbore>(bvh_, prepared_, ray);
-  const PrimitiveSpans prims = scene_.primitives();
-  const Slab::Precomputed slab = Slab::precompute(ray);
-  Hit hit;
-  traverse_bvh2<false>(bvh_, ray, [&](std::uint32_t first, std::uint32_t count, float tmax) {
-    for (std::uint32_t i = first; i < first + count; ++i) {
-      const std::uint32_t id = bvh_.prim_ids[i];
-      const std::size_t local = prims.local(id);
-      float t = 0.0f;
-      bool found = false;
-      switch (prims.kind(id)) {
-        case PrimitiveKind::kTriangle: {
-          TriangleHit th;
-          if (MollerTrumbore::intersect(ray, tmax, prepared_[i], th)) {
-            tmax = th.t;
-            hit = {th.t, static_cast<std::int32_t>(id), th.u, th.v};
-          }
-          continue;
-        }
-        case PrimitiveKind::kSphere: found = intersect_sphere_surface<SpherePrecise>(ray, tmax, prims.spheres[local], t); break;
-        case PrimitiveKind::kBox: found = intersect_box_surface<Slab>(slab, ray, tmax, prims.boxes[local], t); break;
-        case PrimitiveKind::kOrientedBox: found = intersect_obb_surface<Obb>(ray, tmax, prims.obbs[local], t); break;
-      }
-      if (found) {
-        tmax = t;
-        hit = {t, static_cast<std::int32_t>(id), 0.0f, 0.0f};
-      }
-    }
-    return tmax;
-  });
-  return hit;
+  if (scene_.has_analytic()) return intersect_mixed_bvh2<MollerTrumbore>(mixed_, ray);
+  return intersect_bvh2<MollerTrumbore>(bvh_, prepared_, ray);
 }
 
 Camera RayGenerator::default_camera() const {

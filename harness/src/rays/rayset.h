@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "raybench/bvh/bvh2.h"
+#include "raybench/bvh/mixed_bvh2.h"
 #include "raybench/math/ray.h"
 #include "raybench/prim/triangle_mt.h"
 #include "scene/scene.h"
@@ -115,8 +116,9 @@ class RayGenerator {
 
   const Scene& scene_;
   BBox bounds_;
-  Bvh2 bvh_;  // over the triangles, or over every primitive's box when the scene has analytic ones
-  std::vector<MollerTrumbore::Prepared> prepared_;  // in leaf order (unused entries for analytic primitives)
+  Bvh2 bvh_;  // over the triangles of a triangle-only scene
+  std::vector<MollerTrumbore::Prepared> prepared_;  // its triangles in leaf order
+  MixedBvh2<MollerTrumbore> mixed_;  // over every primitive, when the scene has analytic ones
 };
 
 }  // namespace raybench

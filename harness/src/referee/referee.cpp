@@ -148,7 +148,7 @@ Candidate judge_candidate(const PrimitiveSpans& prims, const Ray& ray, std::size
 // primitive still reaches its leaf and is flagged as a near miss: an
 // analytic primitive's box is tight (a box's is the box itself), and a ray
 // grazing its edge would otherwise be culled before the band is looked at.
-std::vector<BBox> primitive_bounds(const PrimitiveSpans& prims) {
+std::vector<BBox> band_grown_bounds(const PrimitiveSpans& prims) {
   std::vector<BBox> bounds(prims.size());
   for (std::size_t id = 0; id < bounds.size(); ++id) {
     BBox b = prims.bounds(id);
@@ -170,7 +170,7 @@ Referee::Referee(const Scene& scene) : scene_(scene) {
     bvh_ = build_bvh2_binned_sah(scene.triangles);
     return;
   }
-  bounds_ = primitive_bounds(scene.primitives());
+  bounds_ = band_grown_bounds(scene.primitives());
   bvh_ = build_bvh2_binned_sah(std::span<const BBox>(bounds_));
 }
 
