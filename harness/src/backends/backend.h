@@ -34,6 +34,10 @@ std::string missing_primitive_types(const Capabilities& capabilities, const Scen
 
 struct BackendConfig {
   int threads = 1;  // threads a backend may use to build
+  // The run's memory policy, the same for every backend: acceleration
+  // structures in transparent huge pages (our BVHs: raybench/bvh/huge_pages.h;
+  // Embree: backends/embree_memory.h), or all of them in ordinary pages.
+  bool huge_pages = true;
 };
 
 std::string backend_accuracy_class(const std::string& name);
