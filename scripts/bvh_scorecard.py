@@ -26,7 +26,9 @@ Prints Markdown (or writes --out). With --out, a picture of the ratios (PNG besi
 """
 import argparse
 import os
+import shlex
 import statistics
+import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -120,13 +122,13 @@ def scorecard(rows, threads=1):
 NOISY_SPREAD = 0.10
 
 
-def run_noise(rows, threads=1):
+def run_noise(rows, threads=1, kinds=RAYSETS):
     """One sentence on how noisy the run was, from Embree's own rows at `threads` (the same code every
     run, so their spread is the machine's): the median spread over the repetitions, the widest, and
     how many rows spread more than NOISY_SPREAD. None without the min and max columns."""
     spreads = sorted(((r["mrays_s_max"] - r["mrays_s_min"]) / r["mrays_s"], r["scene"], r["rayset"], r["backend"])
                      for r in rows if r["backend"] in ("embree", "embree:high") and r["threads"] == threads
-                     and r["rayset"] in RAYSETS and r["mrays_s"] and r.get("mrays_s_min") is not None
+                     and r["rayset"] in kinds and r["mrays_s"] and r.get("mrays_s_min") is not None
                      and r.get("mrays_s_max") is not None)
     if not spreads:
         return None
@@ -214,21 +216,24 @@ def render_each(lines):
     return out
 
 
-def plot_scorecard(path, lines, title):
-    """Two panels of bars grouped by scene, one bar per ray set: our best / Embree's best, and our
-    best watertight / Embree's default mode; whiskers min–max, the target 1.0 dashed."""
+ISSUE4_PANELS = (("ratio", "ratio_range", "our best / Embree's best", 1.0),
+                 ("watertight_ratio", "watertight_range", "our watertight / Embree's default", 1.0))
+
+
+def plot_scorecard(path, lines, title, panels=ISSUE4_PANELS, kinds=RAYSETS):
+    """Panels of bars grouped by scene, one bar per ray kind: by default our best / Embree's best, and
+    our best watertight / Embree's default mode; whiskers min-max, each panel's target dashed."""
     plt = pyplot()
     scenes = list(dict.fromkeys(x["scene"] for x in lines))
     by = {(x["scene"], x["rayset"]): x for x in lines}
-    colors = dict(zip(RAYSETS, ("tab:blue", "tab:orange", "tab:green")))
-    panels = [("ratio", "ratio_range", "our best / Embree's best"),
-              ("watertight_ratio", "watertight_range", "our watertight / Embree's default")]
+    kinds = [k for k in kinds if any(x["rayset"] == k for x in lines)]
+    colors = dict(zip(kinds, ("tab:blue", "tab:orange", "tab:green", "tab:purple")))
     panels = [p for p in panels if any(x[p[0]] is not None for x in lines)]
     groups = scenes + ["geo. mean"]
-    fig, axes = plt.subplots(len(panels), 1, figsize=(figure_width(groups, len(RAYSETS)), 3.6 * len(panels)),
+    fig, axes = plt.subplots(len(panels), 1, figsize=(figure_width(groups, len(kinds)), 3.6 * len(panels)),
                              layout="constrained", squeeze=False)
-    for ax, (key, range_key, label) in zip(axes[:, 0], panels):
-        means = {rs: geometric_mean([x[key] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
+    for ax, (key, range_key, label, target) in zip(axes[:, 0], panels):
+        means = {rs: geometric_mean([x[key] for x in lines if x["rayset"] == rs]) for rs in kinds}
 
         def value_of(scene, rayset):
             if scene == "geo. mean":
@@ -238,18 +243,54 @@ def plot_scorecard(path, lines, title):
                 return None
             span = x[range_key]
             return (x[key], span[0], span[1]) if span else (x[key], None, None)
-        draw_grouped_bars(ax, groups, RAYSETS, colors, value_of)
-        ax.axhline(1.0, color="black", linewidth=1.2, linestyle="--", zorder=4, label="target (= 1.0)")
+        draw_grouped_bars(ax, groups, kinds, colors, value_of)
+        ax.axhline(target, color="black", linewidth=1.2, linestyle="--", zorder=4, label=f"target (= {target:g})")
         ax.axvline(len(scenes) - 0.5, color="grey", linewidth=0.8, zorder=1)
         values = [v for x in lines for v in (x[key], *(x[range_key] or ())) if v is not None]
-        ax.set_ylim(0, max(values + [1.0]) * 1.1)
+        ax.set_ylim(0, max(values + [target]) * 1.1)
         ax.set_ylabel(label + " (×)")
         ax.set_xticklabels(groups)
         rotate_if_crowded(ax, fig, groups)
-        ax.legend(title="ray set (whisker: min–max)", loc="upper left", bbox_to_anchor=(1.0, 1.0), frameon=False)
+        ax.legend(title="ray kind (whisker: min–max)", loc="upper left", bbox_to_anchor=(1.0, 1.0), frameon=False)
     axes[0, 0].set_title(wrap_title(title, fig))
     fig.savefig(path, dpi=DPI)
     plt.close(fig)
+
+
+def issue4_targets(lines):
+    """Issue 4's targets on the single-thread lines: the geometric means and the target table."""
+    ratios = [x["ratio"] for x in lines]
+    per_rayset = {rs: geometric_mean([x["ratio"] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
+    overall = geometric_mean(ratios)
+    wts = [x["watertight_ratio"] for x in lines if x["watertight_ratio"] is not None]
+    build_lines = one_per_scene(lines)
+    builds = [x["build_ratio"] for x in build_lines]
+    out = ["Geometric mean of our best / Embree's best: " +
+            ", ".join(f"{rs} {v:.2f}" for rs, v in per_rayset.items() if v) + (f"; all {overall:.2f}." if overall else "."),
+            "", "| target | measured | |", "|---|---|---|"]
+    if ratios:
+        out.append(f"| our best ≥ 1.0 × Embree's best on every scene and ray set | min {min(ratios):.2f}"
+                   f"{shortfall(lines, 'ratio', 'ratio_range')} | {verdict(min(ratios) >= 1.0)} |")
+        out.append(f"| geometric mean ≥ 1.10 | {overall:.2f} | {verdict(overall >= 1.10)} |")
+    if wts:
+        out.append(f"| watertight ≥ 1.0 × Embree's default mode | min {min(wts):.2f}"
+                   f"{shortfall(lines, 'watertight_ratio', 'watertight_range')} | {verdict(min(wts) >= 1.0)} |")
+    if builds:
+        out.append(f"| default build ≤ 1.0 × Embree medium | max {max(builds):.2f}"
+                   f"{shortfall(build_lines, 'build_ratio', 'build_range', above=True, unit='scenes')} | "
+                   f"{verdict(max(builds) <= 1.0)} |")
+    def worst(key):
+        """The lowest (value, backend, scene, rayset) of `key` over every backend of ours, or None."""
+        found = [(x[key][0], x[key][1], x["scene"], x["rayset"]) for x in lines if x[key] is not None]
+        return min(found) if found else None
+    agree, same = worst("worst_agree_hit"), worst("worst_same_triangle")
+    if agree:
+        out.append(f"| hit/miss agreement ≥ 99.99 %, every backend of ours | min {100 * agree[0]:.3f} % "
+                   f"({agree[1]}, {agree[2]} {agree[3]}) | {verdict(agree[0] >= 0.9999)} |")
+    if same:
+        out.append(f"| same triangle ≥ 99.9 % (ties agree), every backend of ours | min {100 * same[0]:.2f} % "
+                   f"({same[1]}, {same[2]} {same[3]}) | {verdict(same[0] >= 0.999)} |")
+    return out
 
 
 def render(lines, meta, source, rows=(), plot=None):
@@ -280,37 +321,7 @@ def render(lines, meta, source, rows=(), plot=None):
     noise = run_noise(rows)
     if noise:
         out += ["", noise]
-    ratios = [x["ratio"] for x in lines]
-    per_rayset = {rs: geometric_mean([x["ratio"] for x in lines if x["rayset"] == rs]) for rs in RAYSETS}
-    overall = geometric_mean(ratios)
-    wts = [x["watertight_ratio"] for x in lines if x["watertight_ratio"] is not None]
-    build_lines = one_per_scene(lines)
-    builds = [x["build_ratio"] for x in build_lines]
-    out += ["", "Geometric mean of our best / Embree's best: " +
-            ", ".join(f"{rs} {v:.2f}" for rs, v in per_rayset.items() if v) + (f"; all {overall:.2f}." if overall else "."),
-            "", "| target | measured | |", "|---|---|---|"]
-    if ratios:
-        out.append(f"| our best ≥ 1.0 × Embree's best on every scene and ray set | min {min(ratios):.2f}"
-                   f"{shortfall(lines, 'ratio', 'ratio_range')} | {verdict(min(ratios) >= 1.0)} |")
-        out.append(f"| geometric mean ≥ 1.10 | {overall:.2f} | {verdict(overall >= 1.10)} |")
-    if wts:
-        out.append(f"| watertight ≥ 1.0 × Embree's default mode | min {min(wts):.2f}"
-                   f"{shortfall(lines, 'watertight_ratio', 'watertight_range')} | {verdict(min(wts) >= 1.0)} |")
-    if builds:
-        out.append(f"| default build ≤ 1.0 × Embree medium | max {max(builds):.2f}"
-                   f"{shortfall(build_lines, 'build_ratio', 'build_range', above=True, unit='scenes')} | "
-                   f"{verdict(max(builds) <= 1.0)} |")
-    def worst(key):
-        """The lowest (value, backend, scene, rayset) of `key` over every backend of ours, or None."""
-        found = [(x[key][0], x[key][1], x["scene"], x["rayset"]) for x in lines if x[key] is not None]
-        return min(found) if found else None
-    agree, same = worst("worst_agree_hit"), worst("worst_same_triangle")
-    if agree:
-        out.append(f"| hit/miss agreement ≥ 99.99 %, every backend of ours | min {100 * agree[0]:.3f} % "
-                   f"({agree[1]}, {agree[2]} {agree[3]}) | {verdict(agree[0] >= 0.9999)} |")
-    if same:
-        out.append(f"| same triangle ≥ 99.9 % (ties agree), every backend of ours | min {100 * same[0]:.2f} % "
-                   f"({same[1]}, {same[2]} {same[3]}) | {verdict(same[0] >= 0.999)} |")
+    out += [""] + issue4_targets(lines)
     out += render_each(lines)
     if plot:
         out += ["", f"![Our best and our best watertight backend against Embree, per scene and ray set]({plot})"]
@@ -318,36 +329,187 @@ def render(lines, meta, source, rows=(), plot=None):
     return "\n".join(out) + "\n"
 
 
+TARGET_SETS = ("issue33", "issue4")
+# The one command of a machine's scorecard (--run): the default suite's four ray kinds, one and two
+# threads, Embree's medium and high builds beside bvh8, our best candidates and the watertight ones.
+RUN_BACKENDS = ("embree,embree:high,bvh8,bvh8:reinsert,bvh8:sbvh:reinsert,bvh8:mt_edges,bvh8:watertight,"
+                "bvh8:watertight:reinsert,bvh8:watertight:sbvh:reinsert")
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def target_sets(text):
+    names = [t.strip() for t in text.split(",") if t.strip()]
+    unknown = [t for t in names if t not in TARGET_SETS]
+    if unknown or not names:
+        raise argparse.ArgumentTypeError(f"unknown target set '{','.join(unknown) or text}' (known: issue33, issue4)")
+    return list(dict.fromkeys(names))
+
+
+def this_machine():
+    """{cpu, cpu_id} of this machine as raybench's metadata writes them (harness/src/results/metadata.cpp),
+    read from /proc/cpuinfo: enough to name its machine class before the run."""
+    fields = {}
+    with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as f:
+        for line in f:
+            if not line.strip():
+                break
+            key, _, value = line.partition(":")
+            fields[key.strip()] = value.strip()
+    flags = f" {fields.get('flags', '')} "
+    isa = "avx512f" if " avx512f " in flags else "avx2" if " avx2 " in flags else "sse"
+    return {"cpu": fields.get("model name", ""),
+            "cpu_id": f"family {fields.get('cpu family', '?')} model {fields.get('model', '?')} "
+                      f"stepping {fields.get('stepping', '?')}, {isa}"}
+
+
+def run_command(args, machine_class):
+    """The raybench command of --run, and the results CSV it writes, relative to the repository."""
+    directory = os.path.relpath(os.path.abspath(args.machine_dir or os.path.join(REPO, "results", "scorecards")), REPO)
+    csv_path = os.path.join(directory, f"{machine_class}-run.csv")
+    raybench = os.path.relpath(os.path.abspath(args.raybench), REPO) if args.raybench else os.path.join("build", "raybench")
+    return ([raybench, "run", "--backend", args.backend, "--rayset", "primary,diffuse,shadow,uniform",
+             "--threads", "1,2", "--tessellate", "none", "--out", csv_path] + args.raybench_args, csv_path, directory)
+
+
+def scorecard_text(rows, meta, source, sets, plot):
+    """The Markdown of the first target set's scorecard, with the target tables of the others after it;
+    and the summary of issue 33's scorecard (None when it is not the first set)."""
+    import machine_scorecard
+    lines = scorecard(rows)
+    if sets[0] == "issue33":
+        if not meta:
+            raise InputError(source, "no metadata beside it (.meta.toml): issue 33's scorecard names the machine "
+                                     "class from it (or pass --targets issue4)")
+        if not machine_scorecard.rows_of(rows):
+            raise InputError(source, "no single-thread rows of primary, diffuse, shadow or uniform rays with both "
+                                     "Embree and one of our backends")
+        out, facts = machine_scorecard.render(rows, meta, source, plot)
+    else:
+        if not lines:
+            raise InputError(source, "no single-thread primary, diffuse or shadow rows with both Embree and one of our "
+                                     "backends")
+        out, facts = render(lines, meta, source, rows, plot).rstrip("\n").split("\n"), None
+    for extra in sets[1:]:
+        if extra == "issue4":
+            out += ["", "## Issue 4's targets (the earlier set)", "",
+                    "Our best ≥ 1.0 × Embree's best on every row of the primary, diffuse and shadow rays and ≥ 1.10 as "
+                    "their geometric mean, the watertight configuration ≥ 1.0 × `embree`, the default build ≤ 1.0 × "
+                    "Embree's medium build, and agreement with Embree:", ""] + (issue4_targets(lines) if lines else
+                                                                               ["No rows to hold them to."])
+        else:
+            evaluated = machine_scorecard.targets(machine_scorecard.rows_of(rows), rows)
+            out += ["", "## Issue 33's targets", "", "| target | measured | |", "|---|---|---|"]
+            out += [f"| {t['text']} | {t['measured']} | **{t['status']}** |" for t in evaluated]
+    if facts:
+        out += ["", machine_scorecard.summary_comment(facts)]
+    return "\n".join(out) + "\n"
+
+
+def write_scorecard(results, sets, out, plot, machine_dir):
+    """Reads the run, writes the scorecard (stdout without `out`), its picture, and with `machine_dir`
+    the index; returns the Markdown's path or None."""
+    import machine_scorecard
+    rows = read_table(results, REQUIRED, NUMERIC)
+    meta = read_meta(results)
+    if machine_dir:
+        if not meta:
+            raise InputError(results, "no metadata beside it (.meta.toml): cannot name the machine class")
+        name = machine_scorecard.machine_class(meta)
+        out = os.path.join(machine_dir, name + ".md")
+        plot = None if plot is False else os.path.join(machine_dir, name + ".png")
+    elif plot is None:
+        plot = os.path.splitext(out)[0] + ".png" if out else None
+    link = None
+    if plot:
+        if sets[0] == "issue33":
+            lines = machine_scorecard.rows_of(rows)
+            panels = (("bvh8_embree", "bvh8_embree_range", "bvh8 / embree", 1.05),
+                      ("best_best", "best_best_range", "our best / Embree's best", 1.10),
+                      ("wt_embree", "wt_embree_range", "our watertight / embree", 1.05))
+            title = "Issue 33: our BVHs against Embree, one thread, same rays, same run"
+            if meta.get("cpu_id"):
+                title += f" ({machine_scorecard.machine_class(meta)})"
+            if lines:
+                plot_scorecard(plot, lines, title, panels, machine_scorecard.RAY_KINDS)
+            else:
+                plot = None
+        else:
+            lines = scorecard(rows)
+            if lines:
+                plot_scorecard(plot, lines, "Issue 4: our BVHs against Embree, one thread, same rays, same run")
+            else:
+                plot = None
+        if plot:
+            # Linked from the Markdown relative to where it is written.
+            link = os.path.relpath(plot, os.path.dirname(os.path.abspath(out))) if out else plot
+    text = scorecard_text(rows, meta, results, sets, link)
+    if out:
+        with open(out, "w", encoding="utf-8") as f:
+            f.write(text)
+    else:
+        sys.stdout.write(text)
+    if machine_dir:
+        machine_scorecard.write_index(machine_dir)
+    return out
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("results", help="results CSV of a run with embree (and embree:high) beside our backends")
+    parser.add_argument("results", nargs="?", help="results CSV of a run with embree (and embree:high) beside our backends")
+    parser.add_argument("--targets", type=target_sets, default=["issue33"],
+                        help="target sets, the first the scorecard's, the others' tables after it: issue33 (default), "
+                             "issue4, or both as issue33,issue4")
     parser.add_argument("--out", help="write the Markdown here instead of stdout")
+    parser.add_argument("--machine-dir", help="write DIR/<machine class>.md (+ .png) and regenerate DIR/README.md, the "
+                                              "index; with --run, where the run goes (default results/scorecards)")
     parser.add_argument("--plot", help="the picture of the ratios (PNG; default: beside --out, same name; none without --out)")
     parser.add_argument("--no-plot", action="store_true", help="draw no picture")
-    args = parser.parse_args(argv)
-    plot = None if args.no_plot else args.plot or (os.path.splitext(args.out)[0] + ".png" if args.out else None)
+    parser.add_argument("--index", metavar="DIR", help="only regenerate DIR/README.md from the scorecards in DIR")
+    parser.add_argument("--run", action="store_true", help="run raybench for this machine's scorecard first: "
+                        "DIR/<class>-run.csv, then the scorecard and the index (arguments after -- go to raybench)")
+    parser.add_argument("--raybench", help="the raybench binary of --run (default build/raybench)")
+    parser.add_argument("--backend", default=RUN_BACKENDS, help="the backends of --run (default: %(default)s)")
+    parser.add_argument("--dry-run", action="store_true", help="with --run: print the raybench command only")
+    argv = list(sys.argv[1:] if argv is None else argv)
+    raybench_args = argv[argv.index("--") + 1:] if "--" in argv else []
+    args = parser.parse_args(argv[:argv.index("--")] if "--" in argv else argv)
+    args.raybench_args = raybench_args
+    if sum(map(bool, (args.results, args.index, args.run))) != 1:
+        parser.error("give one of: a results CSV, --index DIR, --run")
+    if args.machine_dir and (args.out or args.plot):
+        parser.error("--machine-dir names the scorecard and its picture; no --out or --plot with it")
+    plot = False if args.no_plot else args.plot
     try:
-        rows = read_table(args.results, REQUIRED, NUMERIC)
-        lines = scorecard(rows)
-        if not lines:
-            raise InputError(args.results, "no single-thread primary, diffuse or shadow rows with both Embree and one of our backends")
-        link = None
-        if plot:
-            plot_scorecard(plot, lines, "Issue 4: our BVHs against Embree, one thread, same rays, same run")
-            # Linked from the Markdown relative to where it is written.
-            link = os.path.relpath(plot, os.path.dirname(os.path.abspath(args.out))) if args.out else plot
-        text = render(lines, read_meta(args.results), args.results, rows, link)
+        import machine_scorecard
+        if args.index:
+            if not os.path.isdir(args.index):
+                raise InputError(args.index, "not a directory")
+            count = machine_scorecard.write_index(args.index)
+            print(f"bvh-scorecard: {os.path.join(args.index, 'README.md')}: {count} machine classes")
+            return 0
+        if args.run:
+            name = machine_scorecard.machine_class(this_machine())
+            command, csv_path, directory = run_command(args, name)
+            print(" ".join(shlex.quote(c) for c in command))
+            if args.dry_run:
+                return 0
+            os.makedirs(os.path.join(REPO, directory), exist_ok=True)
+            status = subprocess.run(command, cwd=REPO).returncode
+            if status != 0:
+                raise InputError(command[0], f"raybench run failed (exit {status}); no scorecard written")
+            measured = machine_scorecard.machine_class(read_meta(os.path.join(REPO, csv_path)))
+            if measured != name:
+                raise InputError(csv_path, f"the run's metadata names machine class {measured}, /proc/cpuinfo {name}")
+            args.results, args.machine_dir = os.path.join(REPO, csv_path), os.path.join(REPO, directory)
+        written = write_scorecard(args.results, args.targets, args.out, plot, args.machine_dir)
+        if args.machine_dir:
+            print(f"bvh-scorecard: wrote {written} and {os.path.join(args.machine_dir, 'README.md')}")
     except InputError as e:
         print(f"bvh-scorecard: error: {e}", file=sys.stderr)
         return 2
     except OSError as e:
-        print(f"bvh-scorecard: error: {e.filename or plot}: {e.strerror or e}", file=sys.stderr)
+        print(f"bvh-scorecard: error: {e.filename or args.out or args.results}: {e.strerror or e}", file=sys.stderr)
         return 2
-    if args.out:
-        with open(args.out, "w") as f:
-            f.write(text)
-    else:
-        sys.stdout.write(text)
     return 0
 
 

@@ -1,4 +1,5 @@
-"""scripts/bvh-scorecard on synthetic results: the right best backends, ratios and verdicts."""
+"""scripts/bvh-scorecard on synthetic results: the right best backends, ratios and verdicts, for issue 4's
+targets (Scorecard) and issue 33's per machine class (MachineScorecard)."""
 import csv
 import os
 import subprocess
@@ -36,7 +37,9 @@ class Scorecard(unittest.TestCase):
                 w = csv.DictWriter(f, fieldnames=columns)
                 w.writeheader()
                 w.writerows(rows)
-            return subprocess.run([sys.executable, os.path.join(HERE, "bvh_scorecard.py"), path, *args],
+            # Issue 4's targets, which these tests specify (issue 33's are the default: MachineScorecard).
+            targets = [] if "--targets" in args else ["--targets", "issue4"]
+            return subprocess.run([sys.executable, os.path.join(HERE, "bvh_scorecard.py"), path, *targets, *args],
                                   capture_output=True, text=True)
 
     def test_compares_our_best_with_embrees_best_and_says_which_targets_are_met(self):
@@ -200,6 +203,184 @@ class Scorecard(unittest.TestCase):
         self.assertEqual(result.returncode, 2)
         self.assertEqual(len(result.stderr.strip().splitlines()), 1)
         self.assertIn("bvh-scorecard: error:", result.stderr)
+
+
+INTEL = {"cpu": "Intel(R) Xeon(R) Processor", "cpu_id": "family 6 model 167 stepping 1, avx512f", "date": "2026-11-26T05:11:23Z",
+         "git_commit": "f785ba42d4fcfb25c71ceb00acb3996adba828b3", "embree": "3.13.5"}
+AMD = {"cpu": "AMD EPYC", "cpu_id": "family 26 model 2 stepping 1, avx512f", "date": "2026-11-23T07:35:16Z",
+       "git_commit": "a393124ae9445b7bf9f006fb2c3900dac5d010ad"}
+
+
+def toml_value(v):
+    return "{" + ", ".join(f'"{k}" = {toml_value(x)}' for k, x in v.items()) + "}" if isinstance(v, dict) else f'"{v}"'
+
+
+def write_run(directory, name, rows, meta):
+    """A results CSV (with min/max columns when any row has them) and, unless meta is None, its .meta.toml."""
+    path = os.path.join(directory, name + ".csv")
+    columns = COLUMNS + [c for c in ("mrays_s_min", "mrays_s_max", "build_ms_min", "build_ms_max") if any(c in r for r in rows)]
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=columns)
+        w.writeheader()
+        w.writerows(rows)
+    if meta is not None:
+        with open(os.path.join(directory, name + ".meta.toml"), "w") as f:
+            f.writelines(f"{k} = {toml_value(v)}\n" for k, v in meta.items())
+    return path
+
+
+def scorecard_cli(*args):
+    return subprocess.run([sys.executable, os.path.join(HERE, "bvh_scorecard.py"), *args], capture_output=True, text=True)
+
+
+def issue33_run():
+    """Scenes a and b, four ray kinds, one thread and two. Every target met except where noted."""
+    rows = []
+    for scene in ("a", "b"):
+        for kind in ("primary", "diffuse", "shadow", "uniform"):
+            bvh8 = 10.0 * (1.02 if (scene, kind) == ("b", "uniform") else 1.5)  # b uniform: bvh8 1.02 x embree
+            high = 16.0 if (scene, kind) == ("a", "diffuse") else 9.0           # a diffuse: embree:high beats bvh8
+            watertight = 10.0 * (1.0 if (scene, kind) == ("a", "uniform") else 1.3)  # a uniform: watertight 1.0
+            rows += [spread(row(scene, kind, "embree", 10.0, build=100), 9.9, 10.1),
+                     spread(row(scene, kind, "embree:high", high, build=400), high - 0.1, high + 0.1),
+                     spread(row(scene, kind, "bvh8", bvh8, build=80), bvh8 * 0.9, bvh8 * 1.1),
+                     spread(row(scene, kind, "bvh8:sbvh:reinsert", 16.5 if scene == "a" else 17.0, build=300), 16.0, 17.5),
+                     spread(row(scene, kind, "bvh8:watertight", watertight, build=90), watertight - 0.1, watertight + 0.1),
+                     row(scene, kind, "embree", 18.0, build=60, threads=2),
+                     row(scene, kind, "bvh8", 28.0, build=66 if scene == "b" else 50, threads=2)]  # b: 66 / 60 at 2
+    return rows
+
+
+class MachineScorecard(unittest.TestCase):
+    def test_a_machine_class_is_the_cpus_vendor_family_and_model(self):
+        from machine_scorecard import machine_class
+        from report import InputError
+        self.assertEqual(machine_class(INTEL), "intel-family6-model167")
+        self.assertEqual(machine_class(AMD), "amd-family26-model2")
+        self.assertEqual(machine_class({"cpu": "AuthenticAMD", "cpu_id": "family 25 model 17 stepping 1, avx512f"}),
+                         "amd-family25-model17")
+        self.assertEqual(machine_class({"cpu": "Ampere Altra", "cpu_id": "family 8 model 1 stepping ?, sse"}),
+                         "unknown-family8-model1")
+        for meta in ({"cpu": "AMD EPYC"}, {"cpu": "AMD EPYC", "cpu_id": "family ? model ? stepping ?, sse"}):
+            with self.assertRaisesRegex(InputError, "cannot name the machine class"):
+                machine_class(meta)
+
+    def test_issue33s_targets_name_the_rows_that_miss_and_whether_noise_covers_them(self):
+        with tempfile.TemporaryDirectory() as d:
+            result = scorecard_cli(write_run(d, "run", issue33_run(), INTEL), "--no-plot")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        out = result.stdout
+        self.assertIn("# Scorecard of machine class intel-family6-model167", out)
+        self.assertIn("CPU: Intel(R) Xeon(R) Processor (family 6 model 167 stepping 1, avx512f); ISA: avx512f", out)
+        # A uniform row like any other: bvh8 15 / 10, against embree:high 9, our best 16.5 / 10.
+        self.assertIn("| a | uniform | 1.50 (1.34–1.67) | 1.50 (1.34–1.67) | bvh8:sbvh:reinsert | 1.65 (1.58–1.77) | "
+                      "1.00 (0.98–1.02) |", out)
+        self.assertIn("## Issue 33's targets: 2 of 7 met", out)
+        # b uniform: 10.2 / 10, reaching 11.22 / 9.9 = 1.13 at best: within noise.
+        self.assertIn("| `bvh8` ≥ 1.05 × `embree`, every row (primary, diffuse, shadow, uniform) | min 1.02 (b uniform); "
+                      "1 of 8 rows below 1.05 | **missed** |", out)
+        self.assertIn("b uniform 1.02 (0.91–1.13), within noise.", out)
+        # a diffuse: 15 / 16 against embree:high, at best 16.5 / 15.9 = 1.04.
+        self.assertIn("min 0.94 (a diffuse); 1 of 8 rows below 1.00 | **missed** |", out)
+        # Our best 16.5 or 17 / Embree's best (16 on a diffuse, else 10): one row at 1.03, within noise
+        # (17.5 / 15.9 = 1.10 reaches it).
+        self.assertIn("a diffuse 1.03 (0.99–1.10), within noise", out)
+        self.assertIn("| our best ≥ 1.30 × Embree's best, geometric mean over primary, diffuse, shadow | 1.55 over 6 rows "
+                      "| **met** |", out)
+        # a uniform: watertight 10 / 10, at best 10.1 / 9.9 = 1.02: beyond noise.
+        self.assertIn("| watertight ≥ 1.05 × `embree`, every row (primary, diffuse, shadow, uniform) | min 1.00 (a uniform); "
+                      "1 of 8 rows below 1.05 | **missed** |", out)
+        self.assertIn("a uniform 1.00 (0.98–1.02), beyond noise.", out)
+        self.assertIn("| default build (`bvh8`) ≤ 1.0 × Embree's medium build, 1 thread | max 0.80 (a) | **met** |", out)
+        self.assertIn("| default build (`bvh8`) ≤ 1.0 × Embree's medium build, 2 threads | max 1.10 (b); 1 of 2 scenes "
+                      "above 1.00 | **missed** |", out)
+        self.assertIn("Embree 3.13.5: ISA not recorded; BVH type not recorded; memory policy not recorded.", out)
+
+    def test_a_target_whose_rows_the_run_lacks_is_not_measurable_never_met(self):
+        rows = [r for r in issue33_run() if r["rayset"] != "uniform" and r["threads"] == 1]
+        with tempfile.TemporaryDirectory() as d:
+            out = scorecard_cli(write_run(d, "run", rows, AMD), "--no-plot").stdout
+        self.assertIn("| `bvh8` ≥ 1.05 × `embree`, every row (primary, diffuse, shadow, uniform) | min 1.50 (a primary); "
+                      "the run has no uniform rows | **not measurable** |", out)
+        self.assertIn("| default build (`bvh8`) ≤ 1.0 × Embree's medium build, 2 threads | no rows: no 2-thread rows of "
+                      "bvh8 and embree | **not measurable** |", out)
+        self.assertIn("## Issue 33's targets: 2 of 7 met", out)
+
+    def test_the_header_names_embrees_isa_bvh_and_memory_policy_when_the_metadata_records_them(self):
+        meta = {**INTEL, "memory_policy": "huge pages for both",
+                "provenance": {"embree": {"isa": "AVX512", "bvh": "BVH8"}, "embree:high": {"isa": "AVX512", "bvh": "BVH4"}}}
+        with tempfile.TemporaryDirectory() as d:
+            out = scorecard_cli(write_run(d, "run", issue33_run(), meta), "--no-plot").stdout
+        self.assertIn("Embree 3.13.5: ISA AVX512; BVH type embree: BVH8; embree:high: BVH4; memory policy huge pages for "
+                      "both.", out)
+
+    def test_machine_dir_writes_the_class_scorecard_and_an_index_of_every_class(self):
+        with tempfile.TemporaryDirectory() as d:
+            cards = os.path.join(d, "scorecards")
+            os.mkdir(cards)
+            for name, meta in (("intel", INTEL), ("amd", AMD)):
+                result = scorecard_cli(write_run(d, name, issue33_run(), meta), "--machine-dir", cards)
+                self.assertEqual(result.returncode, 0, result.stderr)
+            self.assertEqual(sorted(os.listdir(cards)), ["README.md", "amd-family26-model2.md", "amd-family26-model2.png",
+                                                         "intel-family6-model167.md", "intel-family6-model167.png"])
+            with open(os.path.join(cards, "intel-family6-model167.md")) as f:
+                self.assertIn("](intel-family6-model167.png)", f.read())
+            with open(os.path.join(cards, "README.md")) as f:
+                index = f.read()
+            # One line per class, by name; our best's geometric mean over the primary, diffuse and shadow rows.
+            amd = index.index("| [amd-family26-model2](amd-family26-model2.md) | AMD EPYC | avx512f | 2026-11-23 | `a393124` | "
+                              "1.55 | 1.43 | 2 of 7 |")
+            intel = index.index("| [intel-family6-model167](intel-family6-model167.md) | Intel(R) Xeon(R) Processor | avx512f | "
+                                "2026-11-26 | `f785ba4` | 1.55 | 1.43 | 2 of 7 |")
+            self.assertLess(amd, intel)
+            # --index alone regenerates it from the scorecards present.
+            os.remove(os.path.join(cards, "amd-family26-model2.md"))
+            self.assertEqual(scorecard_cli("--index", cards).returncode, 0)
+            with open(os.path.join(cards, "README.md")) as f:
+                index = f.read()
+            self.assertNotIn("amd-family26-model2", index)
+            self.assertIn("intel-family6-model167", index)
+
+    def test_both_target_sets_in_one_scorecard(self):
+        with tempfile.TemporaryDirectory() as d:
+            out = scorecard_cli(write_run(d, "run", issue33_run(), AMD), "--targets", "issue33,issue4", "--no-plot").stdout
+        self.assertIn("## Issue 33's targets: 2 of 7 met", out)
+        self.assertIn("## Issue 4's targets (the earlier set)", out)
+        self.assertIn("| geometric mean ≥ 1.10 | 1.55 | **met** |", out)
+
+    def test_run_composes_the_one_raybench_command_of_a_machines_scorecard(self):
+        with tempfile.TemporaryDirectory() as d:
+            result = scorecard_cli("--run", "--dry-run", "--machine-dir", d, "--", "--scene", "bunny")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        command = result.stdout.strip().split()
+        self.assertEqual(command[:2], ["build/raybench", "run"])
+        backends = command[command.index("--backend") + 1].split(",")
+        for b in ("embree", "embree:high", "bvh8", "bvh8:reinsert", "bvh8:sbvh:reinsert", "bvh8:watertight"):
+            self.assertIn(b, backends)
+        self.assertEqual(command[command.index("--rayset") + 1], "primary,diffuse,shadow,uniform")
+        self.assertEqual(command[command.index("--threads") + 1], "1,2")
+        self.assertRegex(command[command.index("--out") + 1], r"/(intel|amd|unknown)-family\d+-model\d+-run\.csv$")
+        self.assertEqual(command[-2:], ["--scene", "bunny"])
+
+    def test_bad_input_is_one_line_and_exit_2(self):
+        with tempfile.TemporaryDirectory() as d:
+            no_meta = write_run(d, "no-meta", issue33_run(), None)
+            no_cpu = write_run(d, "no-cpu", issue33_run(), {"date": "2026-11-26"})
+            bad_columns = os.path.join(d, "bad.csv")
+            with open(bad_columns, "w") as f:
+                f.write("scene,rayset,backend\na,primary,embree\n")
+            with open(os.path.join(d, "bad.meta.toml"), "w") as f:
+                f.write('cpu_id = "family 6 model 167 stepping 1, avx512f"\n')
+            for args, message in (((no_meta, "--no-plot"), "no metadata beside it"),
+                                  ((no_cpu, "--machine-dir", d), "cannot name the machine class"),
+                                  ((bad_columns, "--no-plot"), "missing columns: threads"),
+                                  (("--index", os.path.join(d, "absent")), "not a directory")):
+                result = scorecard_cli(*args)
+                self.assertEqual(result.returncode, 2, args)
+                self.assertEqual(len(result.stderr.strip().splitlines()), 1, result.stderr)
+                self.assertIn("bvh-scorecard: error:", result.stderr)
+                self.assertIn(message, result.stderr)
+            self.assertEqual(scorecard_cli(no_meta, "--targets", "issue5").returncode, 2)
 
 
 if __name__ == "__main__":
