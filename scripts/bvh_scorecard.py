@@ -1,8 +1,13 @@
-"""Issue 4's scorecard: how our BVHs stand against Embree's best, per scene, from one results CSV.
+"""The scorecard of our BVHs against Embree, per scene and per machine class, from one results CSV.
 
-    scripts/bvh-scorecard RESULTS.csv [--out SCORECARD.md] [--plot PICTURE.png | --no-plot]
+    scripts/bvh-scorecard RESULTS.csv [--targets issue33|issue4|issue33,issue4]
+                          [--out SCORECARD.md | --machine-dir DIR] [--plot PICTURE.png | --no-plot]
+    scripts/bvh-scorecard --run [--dry-run] [--machine-dir DIR] [--backend LIST] [-- RAYBENCH OPTIONS]
+    scripts/bvh-scorecard --index DIR
 
-For every scene and the primary, diffuse and shadow ray sets (one thread), it compares:
+Issue 33's targets (the default), the machine class, the index of every class and --run's
+command: machine_scorecard.py. This file: the command line, and issue 4's targets (--targets
+issue4, which reproduces the scorecards made before issue 33). For every scene and the primary, diffuse and shadow ray sets (one thread), it compares:
 - our best backend (every backend not named embree* or reference) with Embree's best (the faster
   of `embree` and `embree:high`, when the run has both): target >= 1.0 per scene and ray set,
   and >= 1.10 as a geometric mean;
@@ -364,9 +369,13 @@ def this_machine():
 
 def run_command(args, machine_class):
     """The raybench command of --run, and the results CSV it writes, relative to the repository."""
-    directory = os.path.relpath(os.path.abspath(args.machine_dir or os.path.join(REPO, "results", "scorecards")), REPO)
+    def in_repo(path):
+        """Relative to the repository when inside it (as the metadata's command then reads), else absolute."""
+        path = os.path.abspath(path)
+        return os.path.relpath(path, REPO) if path.startswith(REPO + os.sep) else path
+    directory = in_repo(args.machine_dir or os.path.join(REPO, "results", "scorecards"))
     csv_path = os.path.join(directory, f"{machine_class}-run.csv")
-    raybench = os.path.relpath(os.path.abspath(args.raybench), REPO) if args.raybench else os.path.join("build", "raybench")
+    raybench = in_repo(args.raybench) if args.raybench else os.path.join("build", "raybench")
     return ([raybench, "run", "--backend", args.backend, "--rayset", "primary,diffuse,shadow,uniform",
              "--threads", "1,2", "--tessellate", "none", "--out", csv_path] + args.raybench_args, csv_path, directory)
 
@@ -500,7 +509,7 @@ def main(argv=None):
             measured = machine_scorecard.machine_class(read_meta(os.path.join(REPO, csv_path)))
             if measured != name:
                 raise InputError(csv_path, f"the run's metadata names machine class {measured}, /proc/cpuinfo {name}")
-            args.results, args.machine_dir = os.path.join(REPO, csv_path), os.path.join(REPO, directory)
+            args.results, args.machine_dir = (os.path.normpath(os.path.join(REPO, p)) for p in (csv_path, directory))
         written = write_scorecard(args.results, args.targets, args.out, plot, args.machine_dir)
         if args.machine_dir:
             print(f"bvh-scorecard: wrote {written} and {os.path.join(args.machine_dir, 'README.md')}")

@@ -222,6 +222,7 @@ def summary(meta, lines, evaluated, source):
             "best_geomean": None if mean is None else round(mean, 2),
             "bvh8_geomean": None if bvh8_mean is None else round(bvh8_mean, 2),
             "met": sum(t["status"] == "met" for t in evaluated), "targets": len(evaluated),
+            "missing_scenes": len(missing_suite_scenes(meta)),
             "not_measurable": sum(t["status"] == "not measurable" for t in evaluated)}
 
 
@@ -324,6 +325,8 @@ def index_lines(directory):
            "| issue 33's targets met |", "|---|---|---|---|---|---:|---:|---|"]
     for name, f in cards:
         unmeasurable = f", {f['not_measurable']} not measurable" if f.get("not_measurable") else ""
+        if f.get("missing_scenes"):
+            unmeasurable += f"; the run lacks {f['missing_scenes']} of today's default-suite scenes"
         fmt = lambda v: "-" if v is None else f"{v:.2f}"  # noqa: E731
         out.append(f"| [{f['class']}]({name}) | {f['cpu']} | {f['isa']} | {f['date']} | `{f['commit']}` | "
                    f"{fmt(f['best_geomean'])} | {fmt(f['bvh8_geomean'])} | {f['met']} of {f['targets']}{unmeasurable} |")
