@@ -494,7 +494,10 @@ def main(argv=None):
             if not os.path.isdir(args.index):
                 raise InputError(args.index, "not a directory")
             count = machine_scorecard.write_index(args.index)
-            print(f"bvh-scorecard: {os.path.join(args.index, 'README.md')}: {count} machine classes")
+            # The same table for the README's headline, its links relative to the current directory.
+            prefix = os.path.relpath(args.index).replace(os.sep, "/") + "/"
+            print(f"bvh-scorecard: {os.path.join(args.index, 'README.md')}: {count} machine classes; for a README here:")
+            print("\n".join(machine_scorecard.index_lines(args.index, prefix)[0]))
             return 0
         if args.run:
             name = machine_scorecard.machine_class(this_machine())

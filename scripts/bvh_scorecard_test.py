@@ -335,7 +335,10 @@ class MachineScorecard(unittest.TestCase):
             self.assertLess(amd, intel)
             # --index alone regenerates it from the scorecards present.
             os.remove(os.path.join(cards, "amd-family26-model2.md"))
-            self.assertEqual(scorecard_cli("--index", cards).returncode, 0)
+            result = scorecard_cli("--index", cards)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            # It prints the table for the README's headline, linked from where it was run.
+            self.assertIn(f"| [intel-family6-model167]({os.path.relpath(cards)}/intel-family6-model167.md) |", result.stdout)
             with open(os.path.join(cards, "README.md")) as f:
                 index = f.read()
             self.assertNotIn("amd-family26-model2", index)

@@ -313,8 +313,9 @@ def read_summary(path):
     return None
 
 
-def index_lines(directory):
-    """The index table's Markdown lines, one per scorecard in `directory`, by machine class."""
+def index_lines(directory, link_prefix=""):
+    """The index table's Markdown lines, one per scorecard in `directory`, by machine class; links
+    prefixed by `link_prefix` (the directory as seen from where the lines go: the README's headline)."""
     cards = []
     for name in sorted(os.listdir(directory)):
         if name.endswith(".md") and name != "README.md":
@@ -328,7 +329,7 @@ def index_lines(directory):
         if f.get("missing_scenes"):
             unmeasurable += f"; the run lacks {f['missing_scenes']} of today's default-suite scenes"
         fmt = lambda v: "-" if v is None else f"{v:.2f}"  # noqa: E731
-        out.append(f"| [{f['class']}]({name}) | {f['cpu']} | {f['isa']} | {f['date']} | `{f['commit']}` | "
+        out.append(f"| [{f['class']}]({link_prefix}{name}) | {f['cpu']} | {f['isa']} | {f['date']} | `{f['commit']}` | "
                    f"{fmt(f['best_geomean'])} | {fmt(f['bvh8_geomean'])} | {f['met']} of {f['targets']}{unmeasurable} |")
     return out, len(cards)
 
