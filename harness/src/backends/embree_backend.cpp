@@ -275,10 +275,11 @@ const EmbreeLibrary& embree_library() {
 // Rays go to Embree as they are: a Ray's first seven floats (org, tnear, dir)
 // are RTCRay's; time, mask, id and flags are set once per batch.
 static_assert(offsetof(Ray, tnear) == offsetof(RTCRay, tnear) && offsetof(Ray, dir) == offsetof(RTCRay, dir_x));
-static_assert(offsetof(RTCRay, org_x) == 0 && sizeof(Vec3f) == 3 * sizeof(float));
+static_assert(offsetof(RTCRay, org_x) == 0 && offsetof(RTCRay, time) == 7 * sizeof(float) &&
+              sizeof(Vec3f) == 3 * sizeof(float));
 
-// An RTCRay with the fields Embree never writes set: time 0, every mask bit,
-// id and flags 0. Its org, tnear, dir and tfar come from load().
+// An RTCRay with the fields Embree never writes set: every mask bit, id and
+// flags 0. Its org, tnear, dir, time (0) and tfar come from load().
 RTCRay batch_ray() {
   RTCRay r;
   r.time = 0.0f;
@@ -288,10 +289,19 @@ RTCRay batch_ray() {
   return r;
 }
 
-// A screened ray (backend.h) into Embree's: three copies.
+// A screened ray (backend.h) into Embree's, in three stores: Embree reads
+// org+tnear and dir+time as 16-byte vectors, which a store of the same 16
+// bytes forwards to at once, while narrower stores make the load wait for
+// them to reach the cache (a store-forwarding stall per vector).
+// Measured: docs/notes/embree-wrapper.md.
 inline void load(RTCRay& out, const Ray& in) {
-  std::memcpy(&out.org_x, &in.org, 4 * sizeof(float));  // org, tnear
-  std::memcpy(&out.dir_x, &in.dir, 3 * sizeof(float));
+  using Float4 = float __attribute__((vector_size(16)));  // GCC's generic vector: no intrinsics needed
+  Float4 org_tnear, dir_time;
+  std::memcpy(&org_tnear, &in.org, sizeof(Float4));
+  std::memcpy(&dir_time, &in.dir, sizeof(Float4));  // dir, tfar
+  dir_time[3] = 0.0f;                                // time
+  std::memcpy(&out.org_x, &org_tnear, sizeof(Float4));
+  std::memcpy(&out.dir_x, &dir_time, sizeof(Float4));
   out.tfar = in.tfar;
 }
 
