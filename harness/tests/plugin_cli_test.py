@@ -80,7 +80,9 @@ class GoodPlugins(PluginCliTestCase):
         backend = "plugin:" + plugin("good_plugin")
         out, result = self.run_suite(backend, backend, scenes=SCENES[:1], raysets="primary")
         self.assertEqual(result.returncode, 0, result.stderr)
-        self.assertEqual(list(read_meta(out)["provenance"]), [backend])  # and the file is valid TOML
+        provenance = read_meta(out)["provenance"]  # and the file is valid TOML
+        # The run's embree (its timing reference) records what Embree selected beside it.
+        self.assertEqual([name for name in provenance if name.startswith("plugin:")], [backend])
 
     def test_the_bvh8_plugin_traces_what_bvh8_traces(self):
         rays = self.path("rays.npy")

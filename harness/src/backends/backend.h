@@ -55,7 +55,9 @@ class Backend {
   // empty for built-in backends.
   virtual std::string plugin_name() const { return {}; }
   // What its results depend on beyond its name, as metadata key/value pairs
-  // (a plugin: its file's absolute path and content hash, its description).
+  // (a plugin: its file's absolute path and content hash, its description;
+  // Embree: the ISA, BVH and intersector it selected). A "summary" pair is
+  // also printed as the run's progress line for the backend.
   virtual std::vector<std::pair<std::string, std::string>> provenance() const { return {}; }
   // Builds the acceleration structure; timed by the caller apart from tracing.
   virtual void build(const Scene& scene) = 0;
@@ -66,9 +68,20 @@ class Backend {
   // where it does not apply or is not known (Embree, the reference).
   virtual double sah_cost() const { return std::numeric_limits<double>::quiet_NaN(); }
 
-  // Closest hit for every ray (t, prim, u, v; a miss leaves the default Hit).
-  // Untraceable rays (see is_traceable) are misses. Called concurrently on
-  // disjoint chunks, so implementations are const and thread-safe.
+  // The rays both take are screened (rays/screening.h, screen_rays), once per
+  // ray set and outside every timing; every caller (a run's timed traces and
+  // agreement, `raybench trace`, the tests) hands over screened rays only:
+  // - origin and direction finite, every |coordinate| <= kLargestTraceableCoordinate;
+  // - 0 <= tnear (a negative tnear was raised to 0), tnear and tfar not NaN;
+  // - the interval (tnear, tfar] may be empty (tfar < tnear, -inf included;
+  //   kEmptyRay stands for a ray screened out): such a ray is a miss and not
+  //   occluded.
+  // So a backend's loop need not screen per ray, and Embree (Debian's, built
+  // with assertions) never sees NaN, Inf or a negative tnear.
+
+  // Closest hit for every ray (t, prim, u, v; a miss is the default Hit).
+  // Called concurrently on disjoint chunks, so implementations are const
+  // and thread-safe.
   virtual void intersect(std::span<const Ray> rays, std::span<Hit> hits) const = 0;
   // Any hit within each ray's interval: 1 when occluded, 0 otherwise.
   virtual void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const = 0;

@@ -15,19 +15,33 @@
 // Embree's sphere and disc semantics as embree_analytic_test.cpp pins them
 // (closed at tnear, tangent hits, the near root's cancellation):
 // docs/backends.md, "Analytic primitives in Embree".
+// Options, the default device config and the record of what Embree selected:
+// embree_options.h, embree_selection.h; docs/backends.md, "Embree's configuration".
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
 #include <sys/types.h>
+#include <cstddef>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <iterator>
+#include <optional>
 #include <vector>
+
+#include <dlfcn.h>
+#include <unistd.h>
 
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
 
 #include "backends/backend.h"
 #include "backends/embree_backend.h"
+#include "backends/embree_options.h"
+#include "backends/embree_selection.h"
 #include "io/error.h"
 #include "raybench/prim/aabb_slab.h"
 #include "raybench/prim/analytic_hit.h"
@@ -37,18 +51,10 @@
 namespace raybench {
 namespace {
 
-// A ray whose interval (max(tnear, 0), tfar] is empty -- tfar below it,
-// tfar = -inf included -- can hit nothing, for every backend. Embree must not
-// be asked: it leaves such a ray's tfar untouched, and rtcOccluded1 reports an
-// occluded ray by setting tfar to -inf, so a ray that came with tfar = -inf
-// would read as occluded.
-bool has_empty_interval(const Ray& r) { return r.tfar < std::max(r.tnear, 0.0f); }
-
-struct EmbreeOptions {
-  RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;
-  bool robust = false;
-  bool disc = false;  // spheres as RTC_GEOMETRY_TYPE_DISC_POINT (see the file's top)
-};
+RTCBuildQuality rtc_quality(EmbreeQuality q) {
+  return q == EmbreeQuality::kLow ? RTC_BUILD_QUALITY_LOW : q == EmbreeQuality::kHigh ? RTC_BUILD_QUALITY_HIGH
+                                                                                       : RTC_BUILD_QUALITY_MEDIUM;
+}
 
 // Embree's geometry ids, one per primitive type (PrimitiveKind's order).
 enum GeometryId : unsigned { kTriangleGeometry = 0, kSphereGeometry = 1, kBoxGeometry = 2, kObbGeometry = 3 };
@@ -105,7 +111,7 @@ void user_bounds(const RTCBoundsFunctionArguments* args) {
                      up(b.upper.x),   up(b.upper.y),   up(b.upper.z),   0.0f};
 }
 
-// The ray as Embree holds it (tnear >= 0 already: fill() raised it), its
+// The ray as Embree holds it (tnear >= 0 already: screening raised it), its
 // current tfar being the closest hit so far.
 inline Ray ray_of(RTCRayN* r, unsigned n, unsigned i) {
   return {{RTCRayN_org_x(r, n, i), RTCRayN_org_y(r, n, i), RTCRayN_org_z(r, n, i)},
@@ -148,19 +154,175 @@ void user_occluded(const RTCOccludedFunctionNArguments* args) {
   }
 }
 
+// ---------------------------------------------------------------------------
+// The probe: what Embree selects for a backend's device config, read from its
+// verbose output (embree_selection.h), once per backend and outside every timing.
+
+// Runs `work` with stdout (fd 1) going to a temporary file and returns what
+// was written there. C and C++ streams are flushed before and after, and fd 1
+// is restored whatever `work` does. Returns "" without running `work` when
+// stdout cannot be redirected, so nothing verbose reaches the user's stdout.
+std::string capture_stdout(const std::function<void()>& work) {
+  std::cout.flush();
+  std::fflush(stdout);
+  FILE* file = std::tmpfile();
+  if (!file) return {};
+  const int saved = ::dup(STDOUT_FILENO);
+  if (saved < 0 || ::dup2(::fileno(file), STDOUT_FILENO) < 0) {
+    if (saved >= 0) ::close(saved);
+    std::fclose(file);
+    return {};
+  }
+  struct Restore {
+    int saved;
+    ~Restore() {
+      std::cout.flush();
+      std::fflush(stdout);
+      ::dup2(saved, STDOUT_FILENO);
+      ::close(saved);
+    }
+  };
+  {
+    const Restore restore{saved};
+    work();
+  }
+  std::string text;
+  if (::lseek(::fileno(file), 0, SEEK_SET) == 0) {
+    char buffer[4096];
+    for (ssize_t n; (n = ::read(::fileno(file), buffer, sizeof buffer)) > 0;) text.append(buffer, static_cast<std::size_t>(n));
+  }
+  std::fclose(file);
+  return text;
+}
+
+// Embree's verbose output of a device made with `device_config` (verbose=2
+// appended: the last value of a key wins) committing one triangle with the
+// backend's build quality and scene flags.
+EmbreeSelection probe_selection(const std::string& device_config, const EmbreeOptions& options) {
+  const std::string text = capture_stdout([&] {
+    RTCDevice device = rtcNewDevice((device_config + ",verbose=2").c_str());
+    if (!device) return;
+    RTCScene scene = rtcNewScene(device);
+    rtcSetSceneBuildQuality(scene, rtc_quality(options.quality));
+    rtcSetSceneFlags(scene, options.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
+    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vertices = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3));
+    auto* indices = static_cast<std::uint32_t*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(std::uint32_t), 1));
+    if (vertices && indices) {
+      const float triangle[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+      std::memcpy(vertices, triangle, sizeof triangle);
+      indices[0] = 0, indices[1] = 1, indices[2] = 2;
+      rtcSetGeometryBuildQuality(geometry, rtc_quality(options.quality));
+      rtcCommitGeometry(geometry);
+      rtcAttachGeometry(scene, geometry);
+      rtcCommitScene(scene);
+    }
+    rtcReleaseGeometry(geometry);
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(device);
+  });
+  return parse_embree_verbose(text);
+}
+
+// One line of a command's output, trimmed; "" when it fails.
+std::string command_output(const std::string& command) {
+  std::string out;
+  if (FILE* p = ::popen(command.c_str(), "r")) {
+    char buffer[512];
+    while (std::fgets(buffer, sizeof buffer, p)) out += buffer;
+    ::pclose(p);
+  }
+  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+  return out.find('\n') == std::string::npos ? out : out.substr(0, out.find('\n'));
+}
+
+// The Embree library this process runs (its file, and the Debian package and
+// version that installed it when dpkg knows it) and whether it was built with
+// assertions (embree_selection.h). The same for every backend: computed once.
+struct EmbreeLibrary {
+  std::string description = kEmbreeUnknown;
+  std::string assertions = kEmbreeUnknown;
+};
+
+const EmbreeLibrary& embree_library() {
+  static const EmbreeLibrary library = [] {
+    EmbreeLibrary out;
+    Dl_info info{};
+    if (!::dladdr(reinterpret_cast<void*>(&rtcNewDevice), &info) || !info.dli_fname) return out;
+    char resolved[4096];
+    const std::string path = ::realpath(info.dli_fname, resolved) ? resolved : info.dli_fname;
+    out.description = path;
+    if (path.find('\'') == std::string::npos) {
+      // "libembree3-3:amd64: /usr/lib/x86_64-linux-gnu/libembree3.so.3.13.5"
+      const std::string owner = command_output("dpkg-query --search '" + path + "' 2>/dev/null");
+      const std::size_t colon = owner.find(": ");
+      if (colon != std::string::npos) {
+        const std::string package = owner.substr(0, colon);
+        const std::string version = command_output("dpkg-query -W -f='${Version}' '" + package + "' 2>/dev/null");
+        out.description += fmt::format(" (Debian package {} {})", package, version.empty() ? kEmbreeUnknown : version);
+      }
+    }
+    std::ifstream file(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    out.assertions = assertions_from_library_bytes(bytes);
+    return out;
+  }();
+  return library;
+}
+
+// Rays go to Embree as they are: a Ray's first seven floats (org, tnear, dir)
+// are RTCRay's; time, mask, id and flags are set once per batch.
+static_assert(offsetof(Ray, tnear) == offsetof(RTCRay, tnear) && offsetof(Ray, dir) == offsetof(RTCRay, dir_x));
+static_assert(offsetof(RTCRay, org_x) == 0 && offsetof(RTCRay, time) == 7 * sizeof(float) &&
+              sizeof(Vec3f) == 3 * sizeof(float));
+
+// An RTCRay with the fields Embree never writes set: every mask bit, id and
+// flags 0. Its org, tnear, dir, time (0) and tfar come from load().
+RTCRay batch_ray() {
+  RTCRay r;
+  r.time = 0.0f;
+  r.mask = 0xffffffffu;
+  r.id = 0;
+  r.flags = 0;
+  return r;
+}
+
+// A screened ray (backend.h) into Embree's, in three stores: Embree reads
+// org+tnear and dir+time as 16-byte vectors, which a store of the same 16
+// bytes forwards to at once, while narrower stores make the load wait for
+// them to reach the cache (a store-forwarding stall per vector).
+// Measured: docs/notes/embree-wrapper.md.
+inline void load(RTCRay& out, const Ray& in) {
+  using Float4 = float __attribute__((vector_size(16)));  // GCC's generic vector: no intrinsics needed
+  Float4 org_tnear, dir_time;
+  std::memcpy(&org_tnear, &in.org, sizeof(Float4));
+  std::memcpy(&dir_time, &in.dir, sizeof(Float4));  // dir, tfar
+  dir_time[3] = 0.0f;                                // time
+  std::memcpy(&out.org_x, &org_tnear, sizeof(Float4));
+  std::memcpy(&out.dir_x, &dir_time, sizeof(Float4));
+  out.tfar = in.tfar;
+}
+
 class EmbreeBackend final : public Backend {
  public:
-  EmbreeBackend(std::string name, EmbreeOptions options)
-      : name_(std::move(name)), options_(options) {
+  EmbreeBackend(std::string name, EmbreeOptions options, const BackendConfig& config)
+      : name_(std::move(name)),
+        options_(std::move(options)),
+        device_config_(embree_device_config(options_, config.huge_pages)),
+        huge_pages_(embree_huge_pages(options_, config.huge_pages)) {
     // No "threads=N": Embree would enforce it with a process-wide
     // tbb::global_control, replaced by each newer device, so while a
     // 1-thread Embree backend was the newest every other backend's 2-thread
     // build ran on one thread (ours measured 1.0x instead of 1.8x). Embree's
     // build runs in the caller's TBB arena instead, which the harness sizes
     // to BackendConfig::threads for every backend alike (TraceExecutor::run).
-    const std::string device_config = "verbose=0";
-    device_ = rtcNewDevice(device_config.c_str());
-    if (!device_) throw std::runtime_error("embree: cannot create a device (" + device_config + ")");
+    device_ = rtcNewDevice(device_config_.c_str());
+    // An ISA the CPU lacks: Embree refuses the device (RTC_ERROR_UNSUPPORTED_CPU).
+    if (!device_)
+      throw InputError("", embree_device_error(name_, options_, device_config_,
+                                               rtcGetDeviceError(nullptr) == RTC_ERROR_UNSUPPORTED_CPU));
     rtcSetDeviceErrorFunction(
         device_, [](void* self, RTCError, const char* message) { static_cast<EmbreeBackend*>(self)->last_error_ = message; },
         this);
@@ -179,6 +341,18 @@ class EmbreeBackend final : public Backend {
 
   const std::string& name() const override { return name_; }
 
+  // What Embree selected for this backend's config (the probe: a second
+  // device, one triangle, committed once) and the library it runs; computed
+  // on the first call, never in a timed loop. Fields the probe cannot read
+  // are "unknown"; it never fails.
+  std::vector<std::pair<std::string, std::string>> provenance() const override {
+    if (!selection_) selection_ = probe_selection(device_config_, options_);
+    const EmbreeLibrary& library = embree_library();
+    auto p = embree_provenance(*selection_, device_config_, huge_pages_, library.description, library.assertions);
+    p.emplace_back("summary", embree_summary(*selection_, huge_pages_));
+    return p;
+  }
+
   Capabilities capabilities() const override {
     Capabilities c;
     c.spheres = c.boxes = c.oriented_boxes = true;
@@ -188,7 +362,7 @@ class EmbreeBackend final : public Backend {
   void build(const Scene& scene) override {
     if (scene_) rtcReleaseScene(scene_);
     scene_ = rtcNewScene(device_);
-    rtcSetSceneBuildQuality(scene_, options_.quality);
+    rtcSetSceneBuildQuality(scene_, rtc_quality(options_.quality));
     rtcSetSceneFlags(scene_, options_.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     const PrimitiveSpans prims = scene.primitives();
     analytic_ = prims.has_analytic();
@@ -220,17 +394,21 @@ class EmbreeBackend final : public Backend {
     else intersect_rays<false>(rays, hits);
   }
 
+  // Rays are screened (backend.h): finite, tnear >= 0, tfar not NaN, the
+  // interval possibly empty (tfar < tnear, -inf included; kEmptyRay). Embree
+  // accepts them as they are (its asserted checks: every |coordinate| <=
+  // FLT_LARGE, |tnear|, |tfar| <= inf, tnear >= 0) and finds nothing in an
+  // empty interval, leaving tfar as it came.
   void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
+    RTCRay ray = batch_ray();
     for (std::size_t i = 0; i < rays.size(); ++i) {
-      occluded[i] = 0;
-      if (!is_traceable(rays[i]) || has_empty_interval(rays[i])) continue;
-      RTCRay ray;
-      fill(ray, rays[i]);
+      load(ray, rays[i]);
       rtcOccluded1(scene_, &context, &ray);
-      // tfar >= 0 went in (the interval is not empty): -inf is Embree's "occluded".
-      occluded[i] = ray.tfar == -std::numeric_limits<float>::infinity() ? 1 : 0;
+      // Embree's "occluded" lowers tfar to -inf; a ray that came with -inf
+      // (an empty interval) cannot be lowered, so it reads as not occluded.
+      occluded[i] = ray.tfar < rays[i].tfar;
     }
   }
 
@@ -239,17 +417,19 @@ class EmbreeBackend final : public Backend {
   void intersect_rays(std::span<const Ray> rays, std::span<Hit> hits) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
+    RTCRayHit rh;
+    rh.ray = batch_ray();
+    // Set once: a hit writes the context's instID[0], which is invalid
+    // without instances (the user callbacks copy it too).
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     for (std::size_t i = 0; i < rays.size(); ++i) {
-      hits[i] = Hit{};
-      if (!is_traceable(rays[i]) || has_empty_interval(rays[i])) continue;  // Debian's Embree asserts on NaN/Inf
-      RTCRayHit rh;
-      fill(rh.ray, rays[i]);
+      load(rh.ray, rays[i]);
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(scene_, &context, &rh);
-      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
-      if constexpr (Analytic) {
+      // Each answer written once.
+      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        hits[i] = Hit{};
+      } else if constexpr (Analytic) {
         const bool triangle = rh.hit.geomID == kTriangleGeometry;
         hits[i] = {rh.ray.tfar, static_cast<std::int32_t>(first_id_[rh.hit.geomID] + rh.hit.primID),
                    triangle ? rh.hit.u : 0.0f, triangle ? rh.hit.v : 0.0f};
@@ -261,7 +441,7 @@ class EmbreeBackend final : public Backend {
 
   // Commits `geometry` and attaches it to the scene under `id`.
   void attach(RTCGeometry geometry, GeometryId id) {
-    rtcSetGeometryBuildQuality(geometry, options_.quality);
+    rtcSetGeometryBuildQuality(geometry, rtc_quality(options_.quality));
     rtcCommitGeometry(geometry);
     rtcAttachGeometryByID(scene_, geometry, id);
     rtcReleaseGeometry(geometry);
@@ -309,24 +489,11 @@ class EmbreeBackend final : public Backend {
     attach(geometry, id);
   }
 
-  static void fill(RTCRay& out, const Ray& in) {
-    const Ray r = with_nonnegative_tnear(in);
-    out.org_x = r.org.x;
-    out.org_y = r.org.y;
-    out.org_z = r.org.z;
-    out.tnear = r.tnear;
-    out.dir_x = r.dir.x;
-    out.dir_y = r.dir.y;
-    out.dir_z = r.dir.z;
-    out.time = 0.0f;
-    out.tfar = r.tfar;
-    out.mask = 0xffffffffu;
-    out.id = 0;
-    out.flags = 0;
-  }
-
   std::string name_;
   EmbreeOptions options_;
+  std::string device_config_;  // embree_device_config
+  bool huge_pages_;            // the memory policy it was given (its option, else the run's)
+  mutable std::optional<EmbreeSelection> selection_;  // the probe's, once provenance() asks
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
   std::string last_error_;
@@ -339,25 +506,23 @@ class EmbreeBackend final : public Backend {
 };
 
 std::unique_ptr<Backend> make_embree_backend(const std::string& name, const std::vector<std::string>& options,
-                                             const BackendConfig&) {
-  EmbreeOptions parsed;
-  for (const std::string& o : options) {
-    if (o == "low") parsed.quality = RTC_BUILD_QUALITY_LOW;
-    else if (o == "medium") parsed.quality = RTC_BUILD_QUALITY_MEDIUM;
-    else if (o == "high") parsed.quality = RTC_BUILD_QUALITY_HIGH;
-    else if (o == "robust") parsed.robust = true;
-    else if (o == "disc") parsed.disc = true;
-    else throw InputError("", fmt::format("backend '{}': unknown embree option '{}' (known: low, medium, high, robust, disc)", name, o));
-  }
-  return std::make_unique<EmbreeBackend>(name, parsed);
+                                             const BackendConfig& config) {
+  return std::make_unique<EmbreeBackend>(name, parse_embree_options(name, options), config);
 }
 
 std::vector<BackendInfo> embree_backend_names() {
-  return {{"embree", "Embree " RTC_VERSION_STRING ", medium build quality (default), rtcIntersect1/rtcOccluded1"},
+  return {{"embree", "Embree " RTC_VERSION_STRING ", medium build quality, frequency_level=simd256, Embree's best ISA "
+                     "(the default: docs/backends.md), rtcIntersect1/rtcOccluded1"},
           {"embree:high", "Embree, high build quality (spatial splits)"},
           {"embree:low", "Embree, low build quality (fast build)"},
           {"embree:robust", "Embree with RTC_SCENE_FLAG_ROBUST (options combine: embree:high:robust)", "robust"},
-          {"embree:disc", "Embree with spheres as ray-facing discs (RTC_GEOMETRY_TYPE_DISC_POINT): hit at the centre's depth, not the surface; for comparison"}};
+          {"embree:disc", "Embree with spheres as ray-facing discs (RTC_GEOMETRY_TYPE_DISC_POINT): hit at the centre's depth, not the surface; for comparison"},
+          {"embree:simd128", "Embree at frequency_level=simd128, its own default on Skylake-class CPUs: a BVH4 "
+                             "instead of a BVH8 (simd256 is the default; simd512 builds as simd256 in Embree 3.13)"},
+          {"embree:hugepages", "Embree with its structures in huge pages whatever the run's memory policy"},
+          {"embree:no_hugepages", "Embree with its structures in ordinary pages whatever the run's memory policy"},
+          {"embree:ISA", "Embree forced to one ISA: embree:sse2, embree:sse4.2, embree:avx, embree:avx2, "
+                         "embree:avx512 (an ISA this CPU lacks is an error)", "fast", false, true}};
 }
 
 }  // namespace

@@ -482,8 +482,10 @@ RunChecks check_run(const RunOptions& options) {
     const std::string& b = settings.backends[i];
     const auto backend = make_backend(b);
     if (std::find(settings.backends.begin(), settings.backends.begin() + i, b) != settings.backends.begin() + i) continue;
-    for (const auto& [key, value] : backend->provenance())
+    for (const auto& [key, value] : backend->provenance()) {
       provenance.emplace_back(fmt::format("provenance.{}.{}", toml_key(b), toml_key(key)), value);
+      if (key == "summary") progress(fmt::format("{}: {}", b, value));
+    }
   }
   const std::string reference = timing_reference(settings);
   if (settings.rays == 0) throw InputError("", "--rays must be at least 1");
