@@ -7,9 +7,11 @@
 // Where the kernel gives no huge pages the memory is ordinary pages, with
 // the same contents. Embree advises its build
 // memory the same way (MADV_HUGEPAGE in its os_malloc). Small arrays stay
-// with operator new.
+// with operator new. The advice is a process-wide switch (set_huge_pages):
+// a run's memory policy holds for every backend alike (docs/backends.md).
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdlib>
 #include <new>
@@ -25,8 +27,24 @@ namespace raybench {
 
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 
+namespace huge_pages_detail {
+inline std::atomic<bool> advise_huge_pages{true};
+}  // namespace huge_pages_detail
+
+// Whether allocate_huge_pages advises its large arrays as huge pages (on by
+// default). Off, they are the same 2 MiB-aligned allocations without the
+// advice: ordinary pages wherever the kernel's THP mode is "madvise".
+// Arrays allocated before a change are freed correctly either way.
+inline void set_huge_pages(bool advise) noexcept {
+  huge_pages_detail::advise_huge_pages.store(advise, std::memory_order_relaxed);
+}
+inline bool huge_pages_enabled() noexcept {
+  return huge_pages_detail::advise_huge_pages.load(std::memory_order_relaxed);
+}
+
 // `bytes` of memory aligned to `alignment` (at most kHugePageBytes); from
-// bytes >= kHugePageBytes on, huge-page aligned and advised as huge pages.
+// bytes >= kHugePageBytes on, huge-page aligned and, while
+// huge_pages_enabled(), advised as huge pages.
 // Release with free_huge_pages(p, bytes) with the same bytes.
 inline void* allocate_huge_pages(std::size_t bytes, std::size_t alignment) {
   if (bytes < kHugePageBytes) return ::operator new(bytes, std::align_val_t(alignment));
@@ -34,7 +52,7 @@ inline void* allocate_huge_pages(std::size_t bytes, std::size_t alignment) {
   void* p = std::aligned_alloc(kHugePageBytes, rounded);
   if (p == nullptr) throw std::bad_alloc();
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-  madvise(p, rounded, MADV_HUGEPAGE);  // advice only: refused, the memory just faults page by page
+  if (huge_pages_enabled()) madvise(p, rounded, MADV_HUGEPAGE);  // advice only: refused, the memory just faults page by page
 #endif
   return p;
 }
