@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <new>
 #include <type_traits>
@@ -43,23 +44,46 @@ inline bool huge_pages_enabled() noexcept {
 }
 
 // `bytes` of memory aligned to `alignment` (at most kHugePageBytes); from
-// bytes >= kHugePageBytes on, huge-page aligned and, while
-// huge_pages_enabled(), advised as huge pages.
+// bytes >= kHugePageBytes on, a fresh huge-page-aligned mapping, advised as
+// huge pages while huge_pages_enabled(). Fresh, not from the heap: memory
+// the heap hands out again was faulted in as small pages before, and stays
+// so whatever the advice (a run's second scene had 0 of bvh8's 4.4 MiB in
+// huge pages: docs/notes/memory-policy.md); Embree's os_malloc maps afresh too.
 // Release with free_huge_pages(p, bytes) with the same bytes.
 inline void* allocate_huge_pages(std::size_t bytes, std::size_t alignment) {
   if (bytes < kHugePageBytes) return ::operator new(bytes, std::align_val_t(alignment));
   const std::size_t rounded = (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
-  void* p = std::aligned_alloc(kHugePageBytes, rounded);
-  if (p == nullptr) throw std::bad_alloc();
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
+#if defined(__linux__)
+  // One huge page more than needed, then the slack on either side unmapped.
+  const std::size_t mapped = rounded + kHugePageBytes;
+  void* raw = mmap(nullptr, mapped, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (raw == MAP_FAILED) throw std::bad_alloc();
+  auto* const start = static_cast<char*>(raw);
+  const std::size_t lead = (kHugePageBytes - reinterpret_cast<std::uintptr_t>(start) % kHugePageBytes) % kHugePageBytes;
+  char* const p = start + lead;
+  if (lead != 0) munmap(start, lead);
+  munmap(p + rounded, mapped - lead - rounded);
+#if defined(MADV_HUGEPAGE)
   if (huge_pages_enabled()) madvise(p, rounded, MADV_HUGEPAGE);  // advice only: refused, the memory just faults page by page
 #endif
   return p;
+#else
+  void* p = std::aligned_alloc(kHugePageBytes, rounded);
+  if (p == nullptr) throw std::bad_alloc();
+  return p;
+#endif
 }
 
 inline void free_huge_pages(void* p, std::size_t bytes, std::size_t alignment) {
-  if (bytes < kHugePageBytes) ::operator delete(p, std::align_val_t(alignment));
-  else std::free(p);
+  if (bytes < kHugePageBytes) {
+    ::operator delete(p, std::align_val_t(alignment));
+    return;
+  }
+#if defined(__linux__)
+  munmap(p, (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes);
+#else
+  std::free(p);
+#endif
 }
 
 // A standard allocator over allocate_huge_pages, for the std::vectors of a
