@@ -241,6 +241,8 @@ TEST(Suite, NumericSettingsAreRefusedNamingTheFileAndKeyNeverAFlag) {
       {"rays = 1e5", "'defaults.rays'"},
       {"rays = \"many\"", "'defaults.rays'"},
       {"seed = -1", "'defaults.seed'"},
+      {"huge_pages = \"yes\"", "'defaults.huge_pages'"},
+      {"huge_pages = true", "'defaults.huge_pages'"},
   };
   int i = 0;
   for (const auto& c : cases) {
@@ -265,6 +267,16 @@ TEST(Suite, NumericSettingsWithinTheRulesAreRead) {
   EXPECT_EQ(s.seed, 0u);
   EXPECT_EQ(s.min_time, 3600.0);
   EXPECT_EQ(s.warmup, 0.0);
+}
+
+// The memory policy is on unless the manifest says "off" ([defaults]
+// huge_pages; --huge-pages overrides it).
+TEST(Suite, TheMemoryPolicyIsHugePagesUnlessTheDefaultsSayOff) {
+  TempDir dir;
+  const std::string scene = "[[scene]]\nname = \"a\"\npath = \"proc:sphere\"\n";
+  EXPECT_TRUE(load_suite(dir.write("none.toml", scene)).settings.huge_pages);
+  EXPECT_TRUE(load_suite(dir.write("on.toml", "[defaults]\nhuge_pages = \"on\"\n" + scene)).settings.huge_pages);
+  EXPECT_FALSE(load_suite(dir.write("off.toml", "[defaults]\nhuge_pages = \"off\"\n" + scene)).settings.huge_pages);
 }
 
 // A camera at NaN, at its own look-at point, or with `up` along the view

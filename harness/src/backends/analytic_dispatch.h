@@ -6,7 +6,9 @@
 // before analytic primitives existed, so its instructions are the same (in
 // one class holding both paths, or beside the mixed instantiations, the
 // compiler inlined and allocated registers otherwise). The price is one more
-// virtual call per batch of rays.
+// virtual call per batch of rays. Being every family's outer object, it
+// also applies the run's memory policy (BackendConfig::huge_pages) to the
+// builds of both.
 #pragma once
 
 #include <functional>
@@ -23,8 +25,10 @@ class AnalyticDispatchBackend final : public Backend {
 
   // `triangles` traces triangle-only scenes; `analytic` makes the backend
   // for scenes with analytic primitives when one is first built;
-  // `capabilities` is what the pair models.
-  AnalyticDispatchBackend(std::unique_ptr<Backend> triangles, Capabilities capabilities, Make analytic);
+  // `capabilities` is what the pair models; `huge_pages` is the memory
+  // policy (raybench/bvh/huge_pages.h's set_huge_pages) set before each build.
+  AnalyticDispatchBackend(std::unique_ptr<Backend> triangles, Capabilities capabilities, Make analytic,
+                          bool huge_pages);
 
   const std::string& name() const override { return triangles_->name(); }
   Capabilities capabilities() const override { return capabilities_; }
@@ -48,6 +52,7 @@ class AnalyticDispatchBackend final : public Backend {
   Make make_analytic_;
   std::unique_ptr<Backend> analytic_;  // while the last scene built has analytic primitives
   Backend* active_;
+  bool huge_pages_;
 };
 
 }  // namespace raybench

@@ -211,7 +211,8 @@ std::unique_ptr<Backend> make_with_analytic(const std::string& name, const std::
   // primitives (its build() of one refuses it).
   const bool binned = parse(F, name, options).builder_or_default() == Bvh2Builder::kBinnedSah;
   return std::make_unique<AnalyticDispatchBackend>(std::move(triangles), binned ? every_type() : Capabilities{},
-                                                   [name, options] { return make_mixed(F, name, options); });
+                                                   [name, options] { return make_mixed(F, name, options); },
+                                                   config.huge_pages);
 }
 
 template <OurBvhFamily F>

@@ -160,7 +160,7 @@ int run(int argc, char** argv) {
   RunOptions run_options;
   std::string suite_path = kDefaultSuite;
   std::vector<std::string> run_raysets, run_backends, run_threads, run_tessellate;
-  std::string run_rays, run_reps, run_build_reps, run_seed, run_min_time, run_warmup, run_reference;
+  std::string run_rays, run_reps, run_build_reps, run_seed, run_min_time, run_warmup, run_reference, run_huge_pages;
   bool no_interleave = false, list_only = false;
   run_options.out_csv = kDefaultOut;
   run_options.rays_dir = kDefaultRaysDir;
@@ -187,6 +187,10 @@ int run(int argc, char** argv) {
   run_cmd->add_option("--warmup", run_warmup, "Untimed warm-up seconds per case, before its first round (default: 0.05)")->type_name("SECONDS");
   run_cmd->add_option("--out,-o", run_options.out_csv, "Results CSV; metadata goes beside it as .meta.toml")->capture_default_str();
   run_cmd->add_option("--rays-dir", run_options.rays_dir, "Where ray sets are stored and reused")->capture_default_str();
+  run_cmd->add_option("--huge-pages", run_huge_pages,
+                      "Memory policy of every backend's acceleration structure: on (transparent huge pages, where the "
+                      "kernel allows them) or off (ordinary pages) (default: the suite's, on)")
+      ->type_name("on|off");
   run_cmd->add_flag("--no-interleave", no_interleave, "Run every round's cases in the same order (backends as listed) instead of a shuffled one");
   run_cmd->add_flag("--list", list_only, "List the suite's scenes and whether they are available, then exit");
   run_cmd->add_option("--accuracy", run_options.accuracy_csv,
@@ -224,6 +228,11 @@ int run(int argc, char** argv) {
   trace_cmd->add_flag("--occluded", trace_occluded,
                       "Any-hit occlusion query instead of closest hit; writes float64 (N, 1): 1 occluded, 0 not");
   trace_cmd->add_option("--threads,-t", trace_threads, "Threads")->capture_default_str()->type_name("INT");
+  std::string trace_huge_pages = "on";
+  trace_cmd->add_option("--huge-pages", trace_huge_pages,
+                        "Memory policy of the backend's acceleration structure: on (transparent huge pages) or off")
+      ->capture_default_str()
+      ->type_name("on|off");
   trace_cmd->add_option("--suite", trace_suite, "Suite manifest to look scene names up in")->capture_default_str();
 
   // raybench kernels
@@ -490,6 +499,7 @@ int run(int argc, char** argv) {
     override_with("--seed", run_seed, seed_setting, &SuiteSettings::seed);
     override_with("--min-time", run_min_time, min_time_setting, &SuiteSettings::min_time);
     override_with("--warmup", run_warmup, warmup_setting, &SuiteSettings::warmup);
+    override_with("--huge-pages", run_huge_pages, huge_pages_setting, &SuiteSettings::huge_pages);
     if (run_cmd->count("--reference"))
       overrides.push_back([v = flag_value("--reference", run_reference, reference_setting)](SuiteSettings& s) {
         s.reference = v;
@@ -547,13 +557,14 @@ int run(int argc, char** argv) {
   }
   if (*trace_cmd) {
     const int threads = flag_value("--threads", trace_threads, threads_setting);
+    const bool huge_pages = flag_value("--huge-pages", trace_huge_pages, huge_pages_setting);
     check_input_file(trace_rays, "ray file (.npy)");
     check_named("--out", trace_out);
     check_outputs({output("--out", trace_out)},
                   {{"--rays", trace_rays, "--rays " + trace_rays}, {"--scene", trace_scene, "--scene " + trace_scene}});
     Suite storage;
     const Suite* suite = suite_if_readable(trace_suite, trace_cmd->count("--suite") > 0, storage);
-    std::unique_ptr<Backend> backend = make_backend(trace_backend, {threads});
+    std::unique_ptr<Backend> backend = make_backend(trace_backend, {threads, huge_pages});
     // What every backend traces (rays/screening.h); untraceable rays answer misses.
     const ScreenedRays screened = screen_rays(read_ray_file(trace_rays));
     const std::vector<Ray>& rays = screened.rays;

@@ -15,6 +15,8 @@
 // observed: docs/notes/harness-measurement.md
 #pragma once
 
+#include <cstddef>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -30,8 +32,13 @@ inline constexpr int kMaxBuildsPerSample = 1000;
 // (inner; max(1, repetitions) of them): each the mean of the builds the round
 // timed for that backend, enough to last about min_seconds. Each backend
 // keeps the tree of its last build.
+// With `huge_page_bytes`, it gets per backend how much the process's
+// anonymous memory in huge pages grew across its warm-up build
+// (page_residency.h; nullopt where unreadable): for a backend not built
+// before, the part of the structure it keeps that landed in huge pages.
 std::vector<std::vector<double>> time_builds_interleaved(std::span<Backend* const> backends, const Scene& scene,
                                                          const TraceExecutor& executor, int repetitions,
-                                                         double min_seconds = 0.0);
+                                                         double min_seconds = 0.0,
+                                                         std::vector<std::optional<std::size_t>>* huge_page_bytes = nullptr);
 
 }  // namespace raybench

@@ -115,6 +115,12 @@ std::string reference_setting(const GivenValue& v) {
   return v.text;
 }
 
+bool huge_pages_setting(const GivenValue& v) {
+  if (v.text == "on") return true;
+  if (v.text == "off") return false;
+  refuse(v, "on or off");
+}
+
 std::string scene_name_problem(std::string_view name) {
   if (name.empty()) return "a scene name must not be empty";
   for (const char c : name) {

@@ -56,6 +56,9 @@ double min_effect_setting(const GivenValue& v);         // finite, in [0, 10]
 // --backend takes it (not empty, no ',' or control character). Whether the
 // run has that backend is checked when the run starts (timing_reference).
 std::string reference_setting(const GivenValue& v);
+// The memory policy (--huge-pages, [defaults] huge_pages): "on" (every
+// backend's acceleration structure in transparent huge pages) or "off".
+bool huge_pages_setting(const GivenValue& v);
 
 // Why `name` cannot name a scene, or "" when it can. A scene's name becomes
 // part of file names in --rays-dir and a field of the results CSV, and is

@@ -304,7 +304,7 @@ Suite load_suite(const std::string& path) {
     const toml::table* t = d->as_table();
     if (!t) r.fail("defaults", "expected a table");
     r.check_keys(*t, "defaults", {"rays", "raysets", "backends", "threads", "repetitions", "build_repetitions", "seed",
-                                  "min_time", "warmup", "reference", "tessellate"});
+                                  "min_time", "warmup", "reference", "tessellate", "huge_pages"});
     r.setting(*t, "defaults.", "rays", rays_setting, s.rays);
     s.raysets = r.strings(*t, "defaults.", "raysets", s.raysets);
     for (const std::string& k : s.raysets) {
@@ -338,6 +338,11 @@ Suite load_suite(const std::string& path) {
       s.reference_given = given.where;
     }
     s.tessellate = r.tessellations(*t, "defaults.").value_or(s.tessellate);
+    if (const toml::node* h = t->get("huge_pages")) {
+      if (!h->is_string()) r.fail("defaults.huge_pages", "must be \"on\" or \"off\"");
+      s.huge_pages = huge_pages_setting(
+          GivenValue::from_manifest(path, "defaults.huge_pages", *h->value<std::string>(), std::nullopt, std::nullopt));
+    }
   }
   const fs::path base = fs::path(path).parent_path();
   if (const toml::node* scenes = root.get("scene")) {

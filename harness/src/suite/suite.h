@@ -71,6 +71,9 @@ struct SuiteSettings {
   // The resolutions every scene with analytic primitives is also traced at
   // as a triangle stand-in ([defaults] tessellate, --tessellate); empty: none.
   std::vector<Tessellation> tessellate;
+  // The memory policy of every backend's acceleration structure ([defaults]
+  // huge_pages = "on" | "off", --huge-pages): BackendConfig::huge_pages.
+  bool huge_pages = true;
 };
 
 struct Suite {

@@ -35,12 +35,18 @@
 #include "suite/results_table.h"
 #include "suite/scene_selection.h"
 #include "suite/settings_rules.h"
+#include "measure/page_residency.h"
 #include "measure/trace.h"
 
 namespace raybench {
 namespace {
 
 void progress(const std::string& line) { std::cerr << "raybench: " << line << std::endl; }
+
+// The build line's "4.0 MiB in huge pages" (build_timing.h's huge_page_bytes).
+std::string describe_huge_pages(const std::optional<std::size_t>& bytes) {
+  return bytes ? fmt::format("{:.1f} MiB in huge pages", *bytes / 1048576.0) : "huge pages unknown";
+}
 
 struct LoadedScene {
   SceneChoice choice;  // choice.entry: null for a scene given by path
@@ -188,7 +194,7 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
     executors.push_back(std::make_unique<TraceExecutor>(threads));
     const TraceExecutor& executor = *executors.back();
     // Embree's answers, per ray set, for agreement.
-    std::unique_ptr<Backend> baseline = make_backend(kAgreementBackend, {threads});
+    std::unique_ptr<Backend> baseline = make_backend(kAgreementBackend, {threads, settings.huge_pages});
     if (const std::string problem = capability_problem(*baseline, scene); !problem.empty())
       throw std::logic_error("the agreement baseline must model every scene: " + problem);
     executor.run([&] { baseline->build(scene); });
@@ -212,17 +218,19 @@ SceneResults measure_scene(const RunOptions& options, const std::string& referen
 
     std::vector<Backend*> built;
     for (const std::string& backend_name : runnable) {
-      backends.push_back(make_backend(backend_name, {threads}));
+      backends.push_back(make_backend(backend_name, {threads, settings.huge_pages}));
       built.push_back(backends.back().get());
     }
-    const std::vector<std::vector<double>> build_times =
-        time_builds_interleaved(built, scene, executor, settings.build_repetitions, settings.min_time);
+    std::vector<std::optional<std::size_t>> huge_page_bytes;
+    const std::vector<std::vector<double>> build_times = time_builds_interleaved(
+        built, scene, executor, settings.build_repetitions, settings.min_time, &huge_page_bytes);
     for (std::size_t bi = 0; bi < built.size(); ++bi) {
       const std::string& backend_name = runnable[bi];
       const Backend* backend = built[bi];
       const std::vector<double>& build_ms = build_times[bi];
-      progress(fmt::format("  built {} ({} threads) in {:.1f} ms, {:.1f} MiB", backend_name, threads, median(build_ms),
-                           backend->memory_bytes() / 1048576.0));
+      progress(fmt::format("  built {} ({} threads) in {:.1f} ms, {:.1f} MiB, {}", backend_name, threads,
+                           median(build_ms), backend->memory_bytes() / 1048576.0,
+                           describe_huge_pages(huge_page_bytes[bi])));
       for (std::size_t r = 0; r < raysets.size(); ++r) {
         const RaySet& rs = raysets[r];
         ResultRow row;
@@ -449,6 +457,10 @@ std::vector<std::string> backends_for_scene(const std::vector<std::string>& name
   return runnable;
 }
 
+std::string memory_policy_description(bool huge_pages) {
+  return huge_pages ? "huge pages for every backend (transparent, madvise)" : "ordinary pages for every backend";
+}
+
 std::string timing_reference(const SuiteSettings& settings) {
   const auto in_run = [&](const std::string& name) {
     return std::find(settings.backends.begin(), settings.backends.end(), name) != settings.backends.end();
@@ -570,6 +582,8 @@ RunResults run_loaded_scenes(const RunOptions& options, const RunChecks& checks,
       {"timing", "rounds"},
       {"reference_backend", reference},
       {"agreement_backend", kAgreementBackend},
+      {"memory_policy", memory_policy_description(settings.huge_pages)},
+      {"thp", transparent_huge_pages_mode()},
   };
   std::vector<std::string> tessellate;
   for (const Tessellation& t : settings.tessellate) tessellate.push_back(t.spec());

@@ -47,6 +47,12 @@ inline constexpr const char* kDefaultTimingReference = "embree";
 // else "" (none).
 std::string timing_reference(const SuiteSettings& settings);
 
+// The run's memory policy as its metadata records it (memory_policy = ...):
+// "huge pages for every backend (transparent, madvise)" or "ordinary pages
+// for every backend". Beside it, thp = the kernel's THP mode
+// (measure/page_residency.h), which decides whether advice is followed.
+std::string memory_policy_description(bool huge_pages);
+
 // A backend a run did not trace on a scene because the scene has a primitive
 // type the backend's capabilities() lack (plugins: anything not a triangle).
 // Printed when it happens and recorded in the metadata as

@@ -7,10 +7,13 @@
 // Where the kernel gives no huge pages the memory is ordinary pages, with
 // the same contents. Embree advises its build
 // memory the same way (MADV_HUGEPAGE in its os_malloc). Small arrays stay
-// with operator new.
+// with operator new. The advice is a process-wide switch (set_huge_pages):
+// a run's memory policy holds for every backend alike (docs/backends.md).
 #pragma once
 
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <new>
 #include <type_traits>
@@ -25,23 +28,62 @@ namespace raybench {
 
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 
+namespace huge_pages_detail {
+inline std::atomic<bool> advise_huge_pages{true};
+}  // namespace huge_pages_detail
+
+// Whether allocate_huge_pages advises its large arrays as huge pages (on by
+// default). Off, they are the same 2 MiB-aligned allocations without the
+// advice: ordinary pages wherever the kernel's THP mode is "madvise".
+// Arrays allocated before a change are freed correctly either way.
+inline void set_huge_pages(bool advise) noexcept {
+  huge_pages_detail::advise_huge_pages.store(advise, std::memory_order_relaxed);
+}
+inline bool huge_pages_enabled() noexcept {
+  return huge_pages_detail::advise_huge_pages.load(std::memory_order_relaxed);
+}
+
 // `bytes` of memory aligned to `alignment` (at most kHugePageBytes); from
-// bytes >= kHugePageBytes on, huge-page aligned and advised as huge pages.
+// bytes >= kHugePageBytes on, a fresh huge-page-aligned mapping, advised as
+// huge pages while huge_pages_enabled(). Fresh, not from the heap: memory
+// the heap hands out again was faulted in as small pages before, and stays
+// so whatever the advice (a run's second scene had 0 of bvh8's 4.4 MiB in
+// huge pages: docs/notes/memory-policy.md); Embree's os_malloc maps afresh too.
 // Release with free_huge_pages(p, bytes) with the same bytes.
 inline void* allocate_huge_pages(std::size_t bytes, std::size_t alignment) {
   if (bytes < kHugePageBytes) return ::operator new(bytes, std::align_val_t(alignment));
   const std::size_t rounded = (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
-  void* p = std::aligned_alloc(kHugePageBytes, rounded);
-  if (p == nullptr) throw std::bad_alloc();
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  madvise(p, rounded, MADV_HUGEPAGE);  // advice only: refused, the memory just faults page by page
+#if defined(__linux__)
+  // One huge page more than needed, then the slack on either side unmapped.
+  const std::size_t mapped = rounded + kHugePageBytes;
+  void* raw = mmap(nullptr, mapped, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (raw == MAP_FAILED) throw std::bad_alloc();
+  auto* const start = static_cast<char*>(raw);
+  const std::size_t lead = (kHugePageBytes - reinterpret_cast<std::uintptr_t>(start) % kHugePageBytes) % kHugePageBytes;
+  char* const p = start + lead;
+  if (lead != 0) munmap(start, lead);
+  munmap(p + rounded, mapped - lead - rounded);
+#if defined(MADV_HUGEPAGE)
+  if (huge_pages_enabled()) madvise(p, rounded, MADV_HUGEPAGE);  // advice only: refused, the memory just faults page by page
 #endif
   return p;
+#else
+  void* p = std::aligned_alloc(kHugePageBytes, rounded);
+  if (p == nullptr) throw std::bad_alloc();
+  return p;
+#endif
 }
 
 inline void free_huge_pages(void* p, std::size_t bytes, std::size_t alignment) {
-  if (bytes < kHugePageBytes) ::operator delete(p, std::align_val_t(alignment));
-  else std::free(p);
+  if (bytes < kHugePageBytes) {
+    ::operator delete(p, std::align_val_t(alignment));
+    return;
+  }
+#if defined(__linux__)
+  munmap(p, (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes);
+#else
+  std::free(p);
+#endif
 }
 
 // A standard allocator over allocate_huge_pages, for the std::vectors of a
