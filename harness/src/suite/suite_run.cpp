@@ -492,7 +492,8 @@ RunChecks check_run(const RunOptions& options) {
   Metadata provenance;
   for (std::size_t i = 0; i < settings.backends.size(); ++i) {
     const std::string& b = settings.backends[i];
-    const auto backend = make_backend(b);
+    // The run's memory policy: Embree's recorded device config depends on it.
+    const auto backend = make_backend(b, {1, settings.huge_pages});
     if (std::find(settings.backends.begin(), settings.backends.begin() + i, b) != settings.backends.begin() + i) continue;
     for (const auto& [key, value] : backend->provenance()) {
       provenance.emplace_back(fmt::format("provenance.{}.{}", toml_key(b), toml_key(key)), value);
