@@ -159,7 +159,7 @@ TEST(Watertight8, Avx2AnswersExactlyAsTheScalarWoopTestEvenThroughEdgesAndVertic
   expect_simd_answers_as_scalar<TriangleVertices8>(
       3, true, 8,
       [](const RandomPack& c, const TriangleVertices8& p, TriangleHit& h) {
-        return intersect8_watertight_avx2(WatertightTriangle::precompute(c.ray), c.tmax, p, h);
+        return intersect8_watertight_simd(WatertightTriangle::precompute(c.ray), c.tmax, p, h);
       },
       [](const RandomPack& c, const TriangleVertices8& p, TriangleHit& h) {
         return intersect8_watertight_scalar(WatertightTriangle::precompute(c.ray), c.tmax, p, h);

@@ -9,9 +9,27 @@
 // kernels run their scalar forms. fmadd is one fused multiply-add, as
 // std::fma: every AVX2 CPU has FMA3, and a build that targets AVX2 without
 // it is refused rather than given a slower or differently rounded form.
+// With AVX-512F and VL (raybench::simd::kHaveAvx512; chosen at compile time,
+// -march=native on such a host) the same widths gain comparisons into a lane
+// mask (vcmpps k, chained under a mask for an and), for the leaf tests; they
+// answer bit for bit as compare-and-movemask. Where AVX-512 did not pay (the
+// node test, in-register compression for the ordered push) and what did:
+// docs/notes/kernels-wide-traversal.md
 #pragma once
 
 #include <cstdint>
+
+#if defined(__AVX2__) && defined(__AVX512F__) && defined(__AVX512VL__)
+#define RAYBENCH_AVX512 1
+#endif
+namespace raybench::simd {
+inline constexpr bool kHaveAvx512 =
+#if defined(RAYBENCH_AVX512)
+    true;
+#else
+    false;
+#endif
+}  // namespace raybench::simd
 
 #if defined(__AVX2__)
 #if !defined(__FMA__)
@@ -63,6 +81,21 @@ struct FloatLanes<8> {
   FloatLanes sign() const { return {_mm256_and_ps(_mm256_set1_ps(-0.0f), v)}; }
   FloatLanes permute(IntLanes<8> index) const { return {_mm256_permutevar8x32_ps(v, index.v)}; }
   unsigned mask() const { return static_cast<unsigned>(_mm256_movemask_ps(v)); }
+#if defined(RAYBENCH_AVX512)
+  // Bit i set when lane i compares true and bit i of `within` is set: one
+  // compare into a mask register (the and comes free), same predicates as
+  // the operators above.
+  unsigned le_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_LE_OQ>(o, within); }
+  unsigned lt_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_LT_OQ>(o, within); }
+  unsigned ge_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_GE_OQ>(o, within); }
+  unsigned gt_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_GT_OQ>(o, within); }
+  unsigned eq_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_EQ_OQ>(o, within); }
+  unsigned ne_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_NEQ_OQ>(o, within); }
+  template <int Predicate>
+  unsigned cmp_mask(FloatLanes o, unsigned within) const {
+    return _mm256_mask_cmp_ps_mask(static_cast<__mmask8>(within), v, o.v, Predicate);
+  }
+#endif
 };
 // max(a, b) / min(a, b): b when either is NaN.
 inline FloatLanes<8> max(FloatLanes<8> a, FloatLanes<8> b) { return {_mm256_max_ps(a.v, b.v)}; }
@@ -109,6 +142,21 @@ struct FloatLanes<4> {
   FloatLanes sign() const { return {_mm_and_ps(_mm_set1_ps(-0.0f), v)}; }
   FloatLanes permute(IntLanes<4> index) const { return {_mm_permutevar_ps(v, index.v)}; }
   unsigned mask() const { return static_cast<unsigned>(_mm_movemask_ps(v)); }
+#if defined(RAYBENCH_AVX512)
+  // Bit i set when lane i compares true and bit i of `within` is set: one
+  // compare into a mask register (the and comes free), same predicates as
+  // the operators above.
+  unsigned le_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_LE_OQ>(o, within); }
+  unsigned lt_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_LT_OQ>(o, within); }
+  unsigned ge_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_GE_OQ>(o, within); }
+  unsigned gt_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_GT_OQ>(o, within); }
+  unsigned eq_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_EQ_OQ>(o, within); }
+  unsigned ne_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_NEQ_OQ>(o, within); }
+  template <int Predicate>
+  unsigned cmp_mask(FloatLanes o, unsigned within) const {
+    return _mm_mask_cmp_ps_mask(static_cast<__mmask8>(within), v, o.v, Predicate);
+  }
+#endif
 };
 inline FloatLanes<4> max(FloatLanes<4> a, FloatLanes<4> b) { return {_mm_max_ps(a.v, b.v)}; }
 inline FloatLanes<4> min(FloatLanes<4> a, FloatLanes<4> b) { return {_mm_min_ps(a.v, b.v)}; }

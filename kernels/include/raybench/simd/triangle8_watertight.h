@@ -7,7 +7,8 @@
 // The triangles' own vertices are stored (v1 = v0 + e1 would be rounded,
 // and neighbours must see bit-identical shared vertices), structure-of-arrays,
 // and their normals, for the hit's distance (the plane's, not the paper's).
-// AVX2 when the compiler targets it, else a scalar loop, same answers.
+// AVX2 when the compiler targets it (its comparisons into mask registers with
+// AVX-512VL), else a scalar loop, same answers.
 // Guarantee: each lane's answer is the scalar test's (watertight, both
 // faces, degenerate and NaN lanes miss); unused lanes hold NaN and never
 // hit; on equal t the last lane wins.
@@ -73,7 +74,7 @@ inline int intersect8_watertight_scalar(const WatertightTriangle::RayData& ray, 
 }
 
 #if defined(__AVX2__)
-RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData& r, float tmax, const TriangleVertices8& t,
+RAYBENCH_INLINE int intersect8_watertight_simd(const WatertightTriangle::RayData& r, float tmax, const TriangleVertices8& t,
                                       TriangleHit& out) {
   // Axis kx of vertex k lies at px + kVertex * k: one base per axis and
   // constant offsets. Indexed as t.v[k][r.kx], the compiler kept nine
@@ -112,8 +113,13 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
   // leaves det NaN: no distance passes the interval, and the scalar test
   // misses it.
   const __m256 smallest = _mm256_min_ps(_mm256_min_ps(u, v), w), largest = _mm256_max_ps(_mm256_max_ps(u, v), w);
+#if defined(RAYBENCH_AVX512)
+  const __mmask8 inside = _mm256_cmp_ps_mask(smallest, zero, _CMP_GT_OQ) | _mm256_cmp_ps_mask(largest, zero, _CMP_LT_OQ);
+  const int exact = _mm256_cmp_ps_mask(smallest, zero, _CMP_EQ_OQ) | _mm256_cmp_ps_mask(largest, zero, _CMP_EQ_OQ);
+#else
   const __m256 inside = _mm256_or_ps(_mm256_cmp_ps(smallest, zero, _CMP_GT_OQ), _mm256_cmp_ps(largest, zero, _CMP_LT_OQ));
   const int exact = _mm256_movemask_ps(_mm256_or_ps(_mm256_cmp_ps(smallest, zero, _CMP_EQ_OQ), _mm256_cmp_ps(largest, zero, _CMP_EQ_OQ)));
+#endif
   const __m256 det = _mm256_add_ps(_mm256_add_ps(u, v), w);
   // The distance to each triangle's plane, as WatertightTriangle::plane_distance.
   constexpr int kToNormal = kVertex * TriangleVertices8::kNormal;  // floats from a vertex-0 row to its normal row
@@ -129,9 +135,14 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
   // A lane strictly inside has det != 0 (three nonzero values of one sign
   // do not sum to 0) and is never one of the exact lanes: no more tests
   // (measured: docs/notes/kernels-triangle-tests.md).
+#if defined(RAYBENCH_AVX512)
+  int mask = _mm256_mask_cmp_ps_mask(_mm256_mask_cmp_ps_mask(inside, tt, _mm256_set1_ps(r.tnear), _CMP_GT_OQ),
+                                     tt, _mm256_set1_ps(WatertightTriangle::finite_tmax(tmax)), _CMP_LE_OQ);
+#else
   const __m256 ok = _mm256_and_ps(inside, _mm256_and_ps(_mm256_cmp_ps(tt, _mm256_set1_ps(r.tnear), _CMP_GT_OQ),
                                                         _mm256_cmp_ps(tt, _mm256_set1_ps(WatertightTriangle::finite_tmax(tmax)), _CMP_LE_OQ)));
   int mask = _mm256_movemask_ps(ok);
+#endif
   if (!mask && !exact) return -1;
   // The barycentrics are divided for the closest lane only.
   alignas(32) float ts[8], vs[8], ws[8], dets[8];
@@ -167,7 +178,7 @@ RAYBENCH_INLINE int intersect8_watertight_avx2(const WatertightTriangle::RayData
 RAYBENCH_INLINE int intersect8_watertight(const WatertightTriangle::RayData& ray, float tmax, const TriangleVertices8& t,
                                  TriangleHit& out) {
 #if defined(__AVX2__)
-  return intersect8_watertight_avx2(ray, tmax, t, out);
+  return intersect8_watertight_simd(ray, tmax, t, out);
 #else
   return intersect8_watertight_scalar(ray, tmax, t, out);
 #endif

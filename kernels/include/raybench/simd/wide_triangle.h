@@ -4,7 +4,8 @@
 // same arithmetic in the same order, so each lane answers exactly as the
 // scalar test, over triangles stored structure-of-arrays, as wide BVH leaves
 // store them. AVX2 (8 lanes) or SSE with FMA (4 lanes) when the
-// compiler targets AVX2, else a scalar loop with the same interface.
+// compiler targets AVX2 (with AVX-512VL its comparisons go into mask
+// registers, same answers), else a scalar loop with the same interface.
 // Möller & Trumbore, "Fast, Minimum Storage Ray/Triangle Intersection",
 // JGT 2(1), 1997.
 // Guarantee: each lane answers as the scalar test (not watertight: a ray
@@ -147,12 +148,22 @@ RAYBENCH_INLINE int intersect_pack_simd(const Ray& ray, float tmax, const Pack& 
   // Ordered, non-signalling comparisons: false for NaN, as the scalar's.
   const F zero = F::set1(0.0f);
   const F tnear = F::set1(ray.tnear);
+#if defined(RAYBENCH_AVX512)
+  // The same five comparisons chained under masks: each ands the last.
+  const unsigned ok = (t_scaled.gt_mask(abs_det * tnear, (u_scaled + v_scaled).le_mask(
+                          abs_det, v_scaled.ge_mask(zero, u_scaled.ge_mask(zero, det.ne_mask(zero))))));
+  if (!ok) return -1;  // most packs: no division
+  const F inv_det = F::set1(1.0f) / abs_det;
+  const F tt = t_scaled * inv_det;
+  unsigned mask = tt.le_mask(F::set1(tmax), tt.gt_mask(tnear, ok));
+#else
   const F ok = (det != zero) & (u_scaled >= zero) & (v_scaled >= zero) & (u_scaled + v_scaled <= abs_det) &
                (t_scaled > abs_det * tnear);
   if (!ok.mask()) return -1;  // most packs: no division
   const F inv_det = F::set1(1.0f) / abs_det;
   const F tt = t_scaled * inv_det;
   unsigned mask = (ok & (tt > tnear) & (tt <= F::set1(tmax))).mask();
+#endif
   if (!mask) return -1;
   alignas(32) float ts[W], us[W], vs[W];
   tt.storeu(ts);
