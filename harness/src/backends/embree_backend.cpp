@@ -41,6 +41,7 @@
 #include "backends/backend.h"
 #include "backends/embree_backend.h"
 #include "backends/embree_options.h"
+#include "io/command_output.h"
 #include "backends/embree_selection.h"
 #include "io/error.h"
 #include "raybench/prim/aabb_slab.h"
@@ -226,18 +227,6 @@ EmbreeSelection probe_selection(const std::string& device_config, const EmbreeOp
   return parse_embree_verbose(text);
 }
 
-// One line of a command's output, trimmed; "" when it fails.
-std::string command_output(const std::string& command) {
-  std::string out;
-  if (FILE* p = ::popen(command.c_str(), "r")) {
-    char buffer[512];
-    while (std::fgets(buffer, sizeof buffer, p)) out += buffer;
-    ::pclose(p);
-  }
-  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
-  return out.find('\n') == std::string::npos ? out : out.substr(0, out.find('\n'));
-}
-
 // The Embree library this process runs (its file, and the Debian package and
 // version that installed it when dpkg knows it) and whether it was built with
 // assertions (embree_selection.h). The same for every backend: computed once.
@@ -256,11 +245,11 @@ const EmbreeLibrary& embree_library() {
     out.description = path;
     if (path.find('\'') == std::string::npos) {
       // "libembree3-3:amd64: /usr/lib/x86_64-linux-gnu/libembree3.so.3.13.5"
-      const std::string owner = command_output("dpkg-query --search '" + path + "' 2>/dev/null");
+      const std::string owner = command_first_line("dpkg-query --search '" + path + "' 2>/dev/null");
       const std::size_t colon = owner.find(": ");
       if (colon != std::string::npos) {
         const std::string package = owner.substr(0, colon);
-        const std::string version = command_output("dpkg-query -W -f='${Version}' '" + package + "' 2>/dev/null");
+        const std::string version = command_first_line("dpkg-query -W -f='${Version}' '" + package + "' 2>/dev/null");
         out.description += fmt::format(" (Debian package {} {})", package, version.empty() ? kEmbreeUnknown : version);
       }
     }

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "io/atomic_file.h"
+#include "io/command_output.h"
 #include "io/default_paths.h"
 #include "backends/embree_backend.h"
 #include "build_info.h"
@@ -58,17 +59,6 @@ std::string cpu_id(const std::map<std::string, std::string>& cpu) {
                      field_or(cpu, "stepping", "?"), isa);
 }
 
-std::string run_command(const std::string& command) {
-  std::string out;
-  if (FILE* p = ::popen(command.c_str(), "r")) {
-    char buffer[256];
-    while (std::fgets(buffer, sizeof buffer, p)) out += buffer;
-    ::pclose(p);
-  }
-  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
-  return out;
-}
-
 std::string toml_string(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
@@ -91,9 +81,9 @@ std::string toml_key(const std::string& name) {
 
 std::string source_state(const std::string& dir) {
   const std::string git = "git -C '" + dir + "' ";
-  std::string commit = run_command(git + "rev-parse HEAD 2>/dev/null");
+  std::string commit = command_output(git + "rev-parse HEAD 2>/dev/null");
   if (commit.empty()) return "unknown";
-  if (!run_command(git + "status --porcelain --untracked-files=no -- . ':(exclude,top)results' 2>/dev/null").empty())
+  if (!command_output(git + "status --porcelain --untracked-files=no -- . ':(exclude,top)results' 2>/dev/null").empty())
     commit += "-dirty";
   return commit;
 }
