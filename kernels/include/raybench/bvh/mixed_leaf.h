@@ -109,8 +109,8 @@ struct AnalyticLeafPrims {
 };
 
 // The boxes the mixed BVHs are built over: prims.bounds(id) for every id,
-// computed on every thread into memory not zeroed first (a serial loop was
-// a tenth of a mixed build on two threads: docs/notes/kernels-builders.md).
+// computed on every thread into memory not zeroed first (the serial loop
+// was 4 % of a mixed build's one-thread profile: docs/notes/kernels-builders.md).
 inline HugePageVector<BBox> primitive_bounds(const PrimitiveSpans& prims) {
   HugePageVector<BBox> bounds;
   bounds.resize(prims.size());
