@@ -19,6 +19,7 @@
 #include <tbb/task_arena.h>
 
 #include "bvh_test_util.h"
+#include "../src/bvh2_build_util.h"
 
 #include "raybench/bvh/bvh2.h"
 #include "raybench/bvh/bvh2_builders.h"
@@ -458,6 +459,64 @@ TEST(Bvh2Quality, TheSweepsRootSplitIsTheCheapestOfAnyBinning) {
             << bins << " bins, leaf granularity " << g;
       }
     }
+  }
+}
+
+// The primitives under a node, appended to `out`.
+void collect_prims(const Bvh2& bvh, std::uint32_t index, std::vector<std::uint32_t>& out) {
+  const Bvh2Node& n = bvh.nodes[index];
+  if (n.is_leaf()) {
+    out.insert(out.end(), bvh.prim_ids.begin() + n.first_index, bvh.prim_ids.begin() + n.first_index + n.prim_count);
+    return;
+  }
+  collect_prims(bvh, n.first_index, out);
+  collect_prims(bvh, n.first_index + 1, out);
+}
+
+TEST(Bvh2Quality, EveryBinnedSplitIsTheCheapestBinPlaneWithItsReferencesSortedByCentroidBin) {
+  // What the binned builder's SIMD partition must agree on with the scalar
+  // definitions: each inner node's children are its references whose
+  // centroid_bin (over the node's centroid box) on the axis of
+  // find_object_split's split is at most its bin, and the others, with the
+  // bins the builder gives a range of n references (min(bin_count,
+  // max(8, n / 2)): bvh2_builder.cpp, bins_for).
+  struct Ref {
+    BBox bounds;
+  };
+  for (const auto& tris : quality_inputs()) {
+    Bvh2BuildOptions options;
+    options.leaf_granularity = 8;
+    options.max_leaf_size = 8;
+    const Bvh2 bvh = build_bvh2_binned_sah(tris, options);
+    int checked = 0;
+    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
+      const Bvh2Node& node = bvh.nodes[i];
+      if (node.is_leaf()) continue;
+      std::vector<std::uint32_t> left, right;
+      collect_prims(bvh, node.first_index, left);
+      collect_prims(bvh, node.first_index + 1, right);
+      std::vector<Ref> refs;
+      BBox centroids;
+      for (const auto* side : {&left, &right})
+        for (std::uint32_t id : *side) {
+          refs.push_back({triangle_bounds(tris[id])});
+          centroids.extend(refs.back().bounds.center());
+        }
+      const std::size_t n = refs.size();
+      const int bins = std::min(options.bin_count, std::max(8, static_cast<int>(std::min<std::size_t>(n / 2, 64))));
+      const bvh2_build::ObjectSplit split =
+          bvh2_build::find_object_split(std::span<const Ref>(refs), centroids, bins, options.leaf_granularity);
+      ASSERT_GE(split.axis, 0) << "node " << i;
+      const float lo = centroids.lower[split.axis];
+      const float scale = static_cast<float>(bins) / (centroids.upper[split.axis] - lo);
+      const auto goes_left = [&](std::uint32_t id) {
+        return bvh2_build::centroid_bin(triangle_bounds(tris[id]).center()[split.axis], lo, scale, bins) <= split.bin;
+      };
+      EXPECT_TRUE(std::all_of(left.begin(), left.end(), goes_left)) << "node " << i << " of " << n << " references";
+      EXPECT_TRUE(std::none_of(right.begin(), right.end(), goes_left)) << "node " << i << " of " << n << " references";
+      ++checked;
+    }
+    EXPECT_GT(checked, 100);
   }
 }
 

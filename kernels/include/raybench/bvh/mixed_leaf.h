@@ -23,7 +23,11 @@
 #include <span>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "raybench/bvh/analytic_test_choice.h"
+#include "raybench/bvh/huge_pages.h"
 #include "raybench/math/ray.h"
 #include "raybench/prim/aabb_slab.h"
 #include "raybench/prim/aabb_slab_seed.h"
@@ -104,10 +108,15 @@ struct AnalyticLeafPrims {
   }
 };
 
-// The boxes the mixed BVHs are built over: prims.bounds(id) for every id.
-inline std::vector<BBox> primitive_bounds(const PrimitiveSpans& prims) {
-  std::vector<BBox> bounds(prims.size());
-  for (std::size_t id = 0; id < bounds.size(); ++id) bounds[id] = prims.bounds(id);
+// The boxes the mixed BVHs are built over: prims.bounds(id) for every id,
+// computed on every thread into memory not zeroed first (the serial loop
+// was 4 % of a mixed build's one-thread profile: docs/notes/kernels-builders.md).
+inline HugePageVector<BBox> primitive_bounds(const PrimitiveSpans& prims) {
+  HugePageVector<BBox> bounds;
+  bounds.resize(prims.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bounds.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t id = r.begin(); id != r.end(); ++id) bounds[id] = prims.bounds(id);
+  });
   return bounds;
 }
 

@@ -37,7 +37,11 @@
 #include <cstdint>
 #include <span>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "raybench/bvh/bvh2.h"
 #include "raybench/bvh/bvh2_reinsertion.h"
@@ -138,14 +142,18 @@ MixedWideBvh<W> build_mixed_wide_bvh(const PrimitiveSpans& prims, int reinsertio
   options.leaf_granularity = quality ? 1 : W;
   options.max_leaf_size = W;  // a BVH2 leaf fits one pack
   options.reinsertion_passes = reinsertion_passes;
-  const std::vector<BBox> bounds = primitive_bounds(prims);
+  const HugePageVector<BBox> bounds = primitive_bounds(prims);
   Bvh2 bvh2 = build_bvh2_binned_sah(std::span<const BBox>(bounds), options);
   if (reinsertion_passes > 0)
     optimize_bvh2_reinsertion(bvh2, {.passes = reinsertion_passes, .max_depth = options.max_sah_depth + 32});
 
-  std::vector<Triangle> stand_ins(prims.size());
-  for (std::size_t id = 0; id < stand_ins.size(); ++id)
-    stand_ins[id] = id < prims.triangles.size() ? prims.triangles[id] : mixed_stand_in(bounds[id]);
+  // Filled on every thread, never zeroed first (as primitive_bounds).
+  HugePageVector<Triangle> stand_ins;
+  stand_ins.resize(prims.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, stand_ins.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t id = r.begin(); id != r.end(); ++id)
+      stand_ins[id] = id < prims.triangles.size() ? prims.triangles[id] : mixed_stand_in(bounds[id]);
+  });
   MixedWideBvh<W> m;
   static_cast<WideBvh<W>&>(m) = collapse_bvh2<W>(bvh2, stand_ins, TriangleLeaf::kLeaves,
                                                  quality ? WideLaneOrder::kOcclusion : WideLaneOrder::kByArea);
@@ -160,11 +168,19 @@ MixedWideBvh<W> build_mixed_wide_bvh(const PrimitiveSpans& prims, int reinsertio
     const std::int32_t id = m.pack_prims[WideBvh<W>::slot(static_cast<std::uint32_t>(p), lane)];
     return id >= 0 && static_cast<std::size_t>(id) >= prims.first_sphere();
   };
+  // Which packs hold analytic primitives, found on every thread; only
+  // those are repacked, in pack order (analytic_refs' order).
+  std::vector<std::uint8_t> is_mixed(pack_count);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pack_count, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t p = r.begin(); p != r.end(); ++p) {
+      bool mixed = false;
+      for (int lane = 0; lane < W; ++lane) mixed = mixed || analytic_lane(p, lane);
+      is_mixed[p] = mixed;
+    }
+  });
   std::vector<MixedPack> infos(pack_count);
   for (std::size_t p = 0; p < pack_count; ++p) {
-    bool mixed = false;
-    for (int lane = 0; lane < W; ++lane) mixed = mixed || analytic_lane(p, lane);
-    if (!mixed) continue;
+    if (!is_mixed[p]) continue;
     std::int32_t ids[W];
     Triangle tris[W];
     int triangles = 0, count = 0;
@@ -210,21 +226,29 @@ MixedWideBvh<W> build_mixed_wide_bvh(const PrimitiveSpans& prims, int reinsertio
       new_index[p] = next++;
       m.mixed_packs.push_back(infos[p]);
     }
+  // Moved on every thread into fresh memory (this function's serial loops
+  // were 5 % of its one-thread profile: docs/notes/kernels-builders.md).
   const auto permute = [&](auto& v, std::size_t per_pack) {
     if (v.empty()) return;
-    const auto old = v;
-    for (std::size_t p = 0; p < pack_count; ++p)
-      std::copy_n(old.begin() + static_cast<std::ptrdiff_t>(p * per_pack), per_pack,
-                  v.begin() + static_cast<std::ptrdiff_t>(new_index[p] * per_pack));
+    std::remove_reference_t<decltype(v)> permuted;
+    permuted.resize(v.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pack_count, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t p = r.begin(); p != r.end(); ++p)
+        std::copy_n(v.begin() + static_cast<std::ptrdiff_t>(p * per_pack), per_pack,
+                    permuted.begin() + static_cast<std::ptrdiff_t>(new_index[p] * per_pack));
+    });
+    v.swap(permuted);
   };
   permute(m.packs, 1);
   permute(m.edge_packs, 1);
   permute(m.vertex_packs, 1);
   permute(m.pack_prims, W);
-  for (WideNode<W>& node : m.nodes)
-    for (std::uint32_t& child : node.child)
-      if (child != WideBvh<W>::kEmptyChild && (child & WideBvh<W>::kLeafBit))
-        child = WideBvh<W>::kLeafBit | new_index[child & ~WideBvh<W>::kLeafBit];
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m.nodes.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i)
+      for (std::uint32_t& child : m.nodes[i].child)
+        if (child != WideBvh<W>::kEmptyChild && (child & WideBvh<W>::kLeafBit))
+          child = WideBvh<W>::kLeafBit | new_index[child & ~WideBvh<W>::kLeafBit];
+  });
   return m;
 }
 
