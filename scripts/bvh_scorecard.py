@@ -373,9 +373,13 @@ def run_command(args, machine_class):
         """Relative to the repository when inside it (as the metadata's command then reads), else absolute."""
         path = os.path.abspath(path)
         return os.path.relpath(path, REPO) if path.startswith(REPO + os.sep) else path
+
+    def program(name):
+        """A bare name stays bare, for the PATH lookup a shell makes; a path is made to work from REPO."""
+        return name if os.sep not in name else in_repo(name)
     directory = in_repo(args.machine_dir or os.path.join(REPO, "results", "scorecards"))
     csv_path = os.path.join(directory, f"{machine_class}-run.csv")
-    raybench = in_repo(args.raybench) if args.raybench else os.path.join("build", "raybench")
+    raybench = program(args.raybench) if args.raybench else os.path.join("build", "raybench")
     return ([raybench, "run", "--backend", args.backend, "--rayset", "primary,diffuse,shadow,uniform",
              "--threads", "1,2", "--tessellate", "none", "--out", csv_path] + args.raybench_args, csv_path, directory)
 
@@ -485,8 +489,11 @@ def main(argv=None):
     args.raybench_args = raybench_args
     if sum(map(bool, (args.results, args.index, args.run))) != 1:
         parser.error("give one of: a results CSV, --index DIR, --run")
-    if args.machine_dir and (args.out or args.plot):
-        parser.error("--machine-dir names the scorecard and its picture; no --out or --plot with it")
+    if (args.machine_dir or args.run) and (args.out or args.plot):
+        print("bvh-scorecard: error: " + ("--run writes DIR/<machine class>.md (+ .png) in --machine-dir DIR (default "
+              "results/scorecards)" if args.run else "--machine-dir names the scorecard and its picture") +
+              "; no --out or --plot with it", file=sys.stderr)
+        return 2
     plot = False if args.no_plot else args.plot
     try:
         import machine_scorecard

@@ -198,6 +198,26 @@ class Scorecard(unittest.TestCase):
         self.assertIn("| bvh8 | 1.04 | - | - | 1.04 | 1 of 2 |", out)  # sqrt(1.2 * 0.9)
         self.assertIn("| bvh8:sbvh | 0.94 | - | - | 0.94 | 1 of 2 |", out)  # sqrt(0.8 * 1.1)
 
+    def test_run_takes_a_bare_raybench_name_from_path_and_a_path_from_where_it_was_given(self):
+        with tempfile.TemporaryDirectory() as d:
+            bare = scorecard_cli("--run", "--dry-run", "--machine-dir", d, "--raybench", "raybench")
+            given = scorecard_cli("--run", "--dry-run", "--machine-dir", d, "--raybench", os.path.join(d, "raybench"))
+        self.assertEqual(bare.returncode, 0, bare.stderr)
+        self.assertEqual(bare.stdout.split()[0], "raybench")  # not <working directory>/raybench
+        self.assertEqual(given.returncode, 0, given.stderr)
+        self.assertEqual(given.stdout.split()[0], os.path.abspath(os.path.join(d, "raybench")))
+
+    def test_run_with_out_or_plot_is_refused_in_one_line(self):
+        with tempfile.TemporaryDirectory() as d:
+            for extra in (("--out", os.path.join(d, "card.md")), ("--plot", os.path.join(d, "card.png"))):
+                result = scorecard_cli("--run", "--dry-run", "--machine-dir", d, *extra)
+                self.assertEqual(result.returncode, 2, extra)
+                self.assertEqual(len(result.stderr.strip().splitlines()), 1, result.stderr)
+                self.assertIn("bvh-scorecard: error: --run writes", result.stderr)
+                self.assertIn("no --out or --plot", result.stderr)
+                self.assertEqual(result.stdout, "")  # no raybench command composed
+            self.assertEqual(os.listdir(d), [])
+
     def test_bad_input_is_one_line_and_exit_2(self):
         result = self.run_on([row("a", "uniform", "embree", 1.0)])
         self.assertEqual(result.returncode, 2)
@@ -209,6 +229,24 @@ INTEL = {"cpu": "Intel(R) Xeon(R) Processor", "cpu_id": "family 6 model 167 step
          "git_commit": "f785ba42d4fcfb25c71ceb00acb3996adba828b3", "embree": "3.13.5"}
 AMD = {"cpu": "AMD EPYC", "cpu_id": "family 26 model 2 stepping 1, avx512f", "date": "2026-11-23T07:35:16Z",
        "git_commit": "a393124ae9445b7bf9f006fb2c3900dac5d010ad"}
+
+
+# The Embree lines of a real run's .meta.toml (build/raybench run --scene sponza_dabrovic,bunny --backend
+# embree,bvh8 --rayset primary --reps 1 --rays 10000, issue 33's code), as raybench writes them.
+REAL_EMBREE_META = """memory_policy = "huge pages for every backend (transparent, madvise)"
+thp = "madvise"
+provenance.embree.isa = "avx512"
+provenance.embree.accel = "BVH8"
+provenance.embree.leaf = "Triangle4"
+provenance.embree.builder = "avx::BVH8BuilderSAH"
+provenance.embree.intersector1 = "BVH8Triangle4Intersector1Moeller"
+provenance.embree.frequency_level = "simd256"
+provenance.embree.huge_pages = "on"
+provenance.embree.embree_hugepages = "enabled"
+provenance.embree.cpu = "Unknown CPU (GenuineIntel)"
+provenance.embree.device_config = "verbose=0,hugepages=1,alloc_thread_block_size=2097088,frequency_level=simd256"
+provenance.embree.summary = "ISA avx512, BVH8 Triangle4, intersector BVH8Triangle4Intersector1Moeller, frequency_level simd256, huge pages on"
+"""
 
 
 def toml_value(v):
@@ -295,6 +333,9 @@ class MachineScorecard(unittest.TestCase):
         self.assertIn("| default build (`bvh8`) ≤ 1.0 × Embree's medium build, 2 threads | max 1.10 (b); 1 of 2 scenes "
                       "above 1.00 | **missed** |", out)
         self.assertIn("Embree 3.13.5: ISA not recorded; BVH type not recorded; memory policy not recorded.", out)
+        # A run without Embree provenance predates issue 33's Embree wrapper fix: its ratios overstate ours.
+        self.assertIn("This run predates issue 33's Embree wrapper fix and memory policy (its metadata records no Embree "
+                      "provenance): Embree was traced through a slower loop, so its ratios overstate ours.", out)
 
     def test_a_target_whose_rows_the_run_lacks_is_not_measurable_never_met(self):
         rows = [r for r in issue33_run() if r["rayset"] != "uniform" and r["threads"] == 1]
@@ -306,13 +347,25 @@ class MachineScorecard(unittest.TestCase):
                       "bvh8 and embree | **not measurable** |", out)
         self.assertIn("## Issue 33's targets: 2 of 7 met", out)
 
-    def test_the_header_names_embrees_isa_bvh_and_memory_policy_when_the_metadata_records_them(self):
-        meta = {**INTEL, "memory_policy": "huge pages for both",
-                "provenance": {"embree": {"isa": "AVX512", "bvh": "BVH8"}, "embree:high": {"isa": "AVX512", "bvh": "BVH4"}}}
+    def test_the_header_names_embrees_isa_bvh_and_memory_policy_from_the_keys_raybench_writes(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = write_run(d, "run", issue33_run(), INTEL)
+            with open(os.path.join(d, "run.meta.toml"), "a") as f:
+                f.write(REAL_EMBREE_META)
+            out = scorecard_cli(path, "--no-plot").stdout
+        self.assertIn("Embree 3.13.5: ISA avx512; BVH type BVH8 Triangle4; memory policy huge pages for every backend "
+                      "(transparent, madvise).", out)
+        self.assertNotIn("predates", out)
+
+    def test_embree_backends_that_differ_are_named_and_huge_pages_stand_in_for_a_missing_run_policy(self):
+        meta = {**INTEL, "provenance": {"embree": {"isa": "avx2", "accel": "BVH4", "leaf": "Triangle4", "huge_pages": "on"},
+                                        "embree:high": {"isa": "avx2", "accel": "BVH8", "leaf": "Triangle4v",
+                                                        "huge_pages": "on"}}}
         with tempfile.TemporaryDirectory() as d:
             out = scorecard_cli(write_run(d, "run", issue33_run(), meta), "--no-plot").stdout
-        self.assertIn("Embree 3.13.5: ISA AVX512; BVH type embree: BVH8; embree:high: BVH4; memory policy huge pages for "
-                      "both.", out)
+        self.assertIn("Embree 3.13.5: ISA avx2; BVH type embree: BVH4 Triangle4; embree:high: BVH8 Triangle4v; memory "
+                      "policy huge pages on.", out)
+        self.assertNotIn("predates", out)
 
     def test_machine_dir_writes_the_class_scorecard_and_an_index_of_every_class(self):
         with tempfile.TemporaryDirectory() as d:

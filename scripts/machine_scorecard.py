@@ -57,37 +57,52 @@ def cpu_isa(meta):
     return parts[1].strip() or None if len(parts) == 2 else None
 
 
-# Where the Embree backends' metadata may record each fact: provenance.<embree backend>.<field>,
-# the first field name found; the memory policy also as the run's top-level memory_policy.
-EMBREE_FACTS = (("ISA", ("isa", "selected_isa", "intersector_isa")),
-                ("BVH type", ("bvh", "bvh_type", "acceleration_structure", "accel")),
-                ("memory policy", ("memory_policy", "huge_pages", "hugepages", "memory")))
+# Where the Embree backends' metadata records each fact, as harness/src/backends/embree_selection.cpp
+# writes it: provenance.<embree backend>.<field>. The BVH type is `accel` with its `leaf` ("BVH8
+# Triangle4"); the memory policy is the run's top-level memory_policy (one policy for every backend,
+# in the kernel's THP mode), else the backends' own `huge_pages` (on/off).
 NOT_RECORDED = "not recorded"
+PREDATES_EMBREE_FIX = ("This run predates issue 33's Embree wrapper fix and memory policy (its metadata records no "
+                       "Embree provenance): Embree was traced through a slower loop, so its ratios overstate ours.")
+
+
+def embree_provenance(meta):
+    """{embree backend: its provenance fields}; {} for a run that predates issue 33's Embree wrapper."""
+    provenance = meta.get("provenance") if isinstance(meta.get("provenance"), dict) else {}
+    return {b: fields for b, fields in provenance.items() if b.startswith("embree") and isinstance(fields, dict)}
+
+
+def _text(value):
+    return str(value).lower() if isinstance(value, bool) else str(value)
+
+
+def _bvh_type(fields):
+    if "accel" not in fields:
+        return None
+    return f"{fields['accel']} {fields['leaf']}" if fields.get("leaf") else _text(fields["accel"])
+
+
+def _merged(per):
+    """One text for every backend when they agree, else "embree: x; embree:high: y"."""
+    if not per:
+        return NOT_RECORDED
+    if len(set(per.values())) == 1:
+        return next(iter(per.values()))
+    return "; ".join(f"{b}: {v}" for b, v in per.items())
 
 
 def embree_config(meta):
     """{fact: text} for Embree's ISA, BVH type and memory policy; per backend when `embree` and
-    `embree:high` differ ("embree: BVH4; embree:high: BVH8"); NOT_RECORDED when absent."""
-    provenance = meta.get("provenance") if isinstance(meta.get("provenance"), dict) else {}
-    embrees = {b: fields for b, fields in provenance.items() if b.startswith("embree") and isinstance(fields, dict)}
-    facts = {}
-    for fact, names in EMBREE_FACTS:
-        per = {}
-        for backend, fields in embrees.items():
-            value = next((fields[n] for n in names if n in fields), None)
-            if value is not None:
-                per[backend] = str(value).lower() if isinstance(value, bool) else str(value)
-        if fact == "memory policy" and "memory_policy" in meta and not per:
-            per = {"": str(meta["memory_policy"])}
-        if not per:
-            facts[fact] = NOT_RECORDED
-        elif len(set(per.values())) == 1:
-            facts[fact] = next(iter(per.values()))
-        else:
-            facts[fact] = "; ".join(f"{b}: {v}" for b, v in per.items())
-    if "memory_policy" in meta and facts["memory policy"] != str(meta["memory_policy"]):
-        facts["memory policy"] = f"{meta['memory_policy']} (run); {facts['memory policy']}"
-    return facts
+    `embree:high` differ ("embree: BVH4 Triangle4; embree:high: BVH8 Triangle4"); NOT_RECORDED when
+    absent."""
+    embrees = embree_provenance(meta)
+    isa = {b: _text(f["isa"]) for b, f in embrees.items() if "isa" in f}
+    bvh = {b: t for b, t in ((b, _bvh_type(f)) for b, f in embrees.items()) if t is not None}
+    if "memory_policy" in meta:
+        memory = str(meta["memory_policy"])
+    else:
+        memory = _merged({b: f"huge pages {_text(f['huge_pages'])}" for b, f in embrees.items() if "huge_pages" in f})
+    return {"ISA": _merged(isa), "BVH type": _merged(bvh), "memory policy": memory}
 
 
 def fastest(backends, names):
@@ -258,6 +273,8 @@ def header(meta, source):
     facts = embree_config(meta)
     out.append(f"Embree {meta.get('embree', '(version not recorded)')}: " +
                "; ".join(f"{fact} {value}" for fact, value in facts.items()) + ".")
+    if not embree_provenance(meta):
+        out.append(PREDATES_EMBREE_FIX)
     return out
 
 

@@ -90,9 +90,37 @@ TEST(MemoryPolicy, TheSettingIsOnOrOffAndAnythingElseIsOneLineNamingWhereItWasGi
   }
 }
 
-TEST(MemoryPolicy, TheMetadataSaysWhichPolicyHeldForEveryBackend) {
-  EXPECT_EQ(memory_policy_description(true), "huge pages for every backend (transparent, madvise)");
-  EXPECT_EQ(memory_policy_description(false), "ordinary pages for every backend");
+TEST(MemoryPolicy, UnderMadviseTheMetadataSaysWhichPolicyHeldForEveryBackend) {
+  EXPECT_EQ(memory_policy_description(true, "madvise"), "huge pages for every backend (transparent, madvise)");
+  EXPECT_EQ(memory_policy_description(false, "madvise"), "ordinary pages for every backend");
+}
+
+// Under "always" nothing is advised off huge pages (Embree's memory cannot
+// be), so "off" is a request the kernel may overrule, and "on" owes nothing
+// to advice.
+TEST(MemoryPolicy, UnderAlwaysOffIsOnlyARequestAndOnIsNotMadvise) {
+  EXPECT_EQ(memory_policy_description(false, "always"),
+            "ordinary pages requested for every backend, but the kernel's THP mode 'always' may give any of them "
+            "huge pages");
+  const std::string on = memory_policy_description(true, "always");
+  EXPECT_EQ(on, "huge pages for every backend (transparent, the kernel's THP mode 'always')");
+  EXPECT_EQ(on.find("madvise"), std::string::npos) << on;
+}
+
+TEST(MemoryPolicy, UnderNeverNoBackendGetsHugePages) {
+  const std::string on = memory_policy_description(true, "never");
+  EXPECT_EQ(on, "huge pages requested for every backend, but the kernel's THP mode 'never' gives none of them huge pages");
+  EXPECT_EQ(on.find("madvise"), std::string::npos) << on;
+  EXPECT_EQ(memory_policy_description(false, "never"), "ordinary pages for every backend");
+}
+
+TEST(MemoryPolicy, AnUnknownModeIsSaidToBeUnknown) {
+  for (const char* mode : {"unavailable", ""}) {
+    EXPECT_EQ(memory_policy_description(true, mode),
+              "huge pages requested for every backend (transparent, madvise); the kernel's THP mode is unknown");
+    EXPECT_EQ(memory_policy_description(false, mode),
+              "ordinary pages requested for every backend; the kernel's THP mode is unknown");
+  }
 }
 
 // Embree 3.13's blocks reach its advised os_malloc only at exactly

@@ -1,11 +1,11 @@
-// Specification that the wide traversal's AVX-512 path (mask registers and
-// in-register compression: simd/lanes.h, simd/wide_box.h, simd/wide_triangle.h,
-// simd/triangle8_watertight.h, bvh/wide_bvh_traverse.h) answers bit for bit
-// as its AVX2 path. This file is built twice (kernels/tests/CMakeLists.txt):
+// Specification that the wide traversal's AVX-512 leaf tests (comparisons
+// into mask registers: simd/lanes.h, simd/wide_triangle.h,
+// simd/triangle8_watertight.h) answer bit for bit as the AVX2 ones
+// (compare-and-movemask). This file is built twice (kernels/tests/CMakeLists.txt):
 // for AVX2, where it writes every answer to the file RAYBENCH_WIDE_ANSWERS
 // names, and for AVX-512, where it compares its own answers with that file
 // (a ctest fixture runs the writer first). The trees are built by the same
-// code from the same triangles, so only the traversal and leaf tests differ.
+// code from the same triangles, so only the leaf tests' instructions differ.
 // The rays: every kind of bvh_test_util.h on a mesh with shared edges and on
 // a soup with degenerate triangles and a partly filled last pack, rays aimed
 // exactly at vertices (the watertight test's exact lanes), axis-parallel,

@@ -69,15 +69,19 @@ class Backend {
   virtual double sah_cost() const { return std::numeric_limits<double>::quiet_NaN(); }
 
   // The rays both take are screened (rays/screening.h, screen_rays), once per
-  // ray set and outside every timing; every caller (a run's timed traces and
-  // agreement, `raybench trace`, the tests) hands over screened rays only:
+  // ray set and outside every timing, by every caller that may reach Embree or
+  // a plugin (a run's timed traces and agreement, `raybench trace`):
   // - origin and direction finite, every |coordinate| <= kLargestTraceableCoordinate;
   // - 0 <= tnear (a negative tnear was raised to 0), tnear and tfar not NaN;
   // - the interval (tnear, tfar] may be empty (tfar < tnear, -inf included;
   //   kEmptyRay stands for a ray screened out): such a ray is a miss and not
   //   occluded.
-  // So a backend's loop need not screen per ray, and Embree (Debian's, built
-  // with assertions) never sees NaN, Inf or a negative tnear.
+  // Embree requires screened rays (Debian's, built with assertions, aborts on
+  // NaN, Inf or a negative tnear), and plugins are promised them
+  // (docs/plugins.md). Our built-in backends take unscreened rays as well:
+  // they answer an untraceable ray (is_traceable, math/ray.h) as a miss, not
+  // occluded, and raise a negative tnear to 0 per ray, as screening would
+  // (tests/mixed_backend_test.cpp hands them such rays on purpose).
 
   // Closest hit for every ray (t, prim, u, v; a miss is the default Hit).
   // Called concurrently on disjoint chunks, so implementations are const

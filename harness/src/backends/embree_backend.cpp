@@ -24,12 +24,16 @@
 #include <sys/types.h>
 #include <cstddef>
 #include <cstdio>
+#include <cerrno>
 #include <cstring>
+#include <exception>
 #include <fstream>
 #include <functional>
 #include <iostream>
 #include <iterator>
+#include <memory>
 #include <optional>
+#include <stdexcept>
 #include <vector>
 
 #include <dlfcn.h>
@@ -159,40 +163,59 @@ void user_occluded(const RTCOccludedFunctionNArguments* args) {
 // The probe: what Embree selects for a backend's device config, read from its
 // verbose output (embree_selection.h), once per backend and outside every timing.
 
+struct CloseFile {
+  void operator()(std::FILE* file) const { std::fclose(file); }
+};
+
+// dup2(from, to), retried while it is interrupted (EINTR) or races another
+// thread's open (EBUSY), its only failures for two open descriptors.
+bool redirect_descriptor(int from, int to) {
+  for (int attempt = 0; attempt < 1000; ++attempt) {
+    if (::dup2(from, to) >= 0) return true;
+    if (errno != EINTR && errno != EBUSY) return false;
+  }
+  return false;
+}
+
 // Runs `work` with stdout (fd 1) going to a temporary file and returns what
 // was written there. C and C++ streams are flushed before and after, and fd 1
-// is restored whatever `work` does. Returns "" without running `work` when
-// stdout cannot be redirected, so nothing verbose reaches the user's stdout.
+// is restored whether `work` returns or throws (its exception is rethrown).
+// Returns "" without running `work` when stdout cannot be redirected (the
+// probe's fields are then "unknown"), so nothing verbose reaches the user's
+// stdout; throws std::runtime_error if fd 1 cannot be restored, rather than
+// run on with the user's stdout going to a deleted file.
 std::string capture_stdout(const std::function<void()>& work) {
   std::cout.flush();
   std::fflush(stdout);
-  FILE* file = std::tmpfile();
+  const std::unique_ptr<std::FILE, CloseFile> file(std::tmpfile());
   if (!file) return {};
   const int saved = ::dup(STDOUT_FILENO);
-  if (saved < 0 || ::dup2(::fileno(file), STDOUT_FILENO) < 0) {
-    if (saved >= 0) ::close(saved);
-    std::fclose(file);
+  if (saved < 0) return {};
+  if (!redirect_descriptor(::fileno(file.get()), STDOUT_FILENO)) {
+    ::close(saved);
     return {};
   }
-  struct Restore {
-    int saved;
-    ~Restore() {
-      std::cout.flush();
-      std::fflush(stdout);
-      ::dup2(saved, STDOUT_FILENO);
-      ::close(saved);
-    }
-  };
-  {
-    const Restore restore{saved};
+  std::exception_ptr failure;
+  try {
     work();
+  } catch (...) {
+    failure = std::current_exception();
   }
+  std::cout.flush();
+  std::fflush(stdout);
+  const bool restored = redirect_descriptor(saved, STDOUT_FILENO);
+  const int restore_error = errno;
+  ::close(saved);
+  if (!restored)
+    throw std::runtime_error(fmt::format("cannot restore stdout after probing Embree's selection: {}",
+                                         std::strerror(restore_error)));
+  if (failure) std::rethrow_exception(failure);
   std::string text;
-  if (::lseek(::fileno(file), 0, SEEK_SET) == 0) {
+  if (::lseek(::fileno(file.get()), 0, SEEK_SET) == 0) {
     char buffer[4096];
-    for (ssize_t n; (n = ::read(::fileno(file), buffer, sizeof buffer)) > 0;) text.append(buffer, static_cast<std::size_t>(n));
+    for (ssize_t n; (n = ::read(::fileno(file.get()), buffer, sizeof buffer)) > 0;)
+      text.append(buffer, static_cast<std::size_t>(n));
   }
-  std::fclose(file);
   return text;
 }
 
@@ -262,13 +285,16 @@ const EmbreeLibrary& embree_library() {
 }
 
 // Rays go to Embree as they are: a Ray's first seven floats (org, tnear, dir)
-// are RTCRay's; time, mask, id and flags are set once per batch.
+// are RTCRay's, and its eighth (tfar) sits where RTCRay has time, so load()
+// stores dir+time as one 16-byte vector with time = 0, per ray; mask, id and
+// flags are set once per batch (batch_ray).
 static_assert(offsetof(Ray, tnear) == offsetof(RTCRay, tnear) && offsetof(Ray, dir) == offsetof(RTCRay, dir_x));
+static_assert(offsetof(Ray, tfar) == 7 * sizeof(float));
 static_assert(offsetof(RTCRay, org_x) == 0 && offsetof(RTCRay, time) == 7 * sizeof(float) &&
               sizeof(Vec3f) == 3 * sizeof(float));
 
 // An RTCRay with the fields Embree never writes set: every mask bit, id and
-// flags 0. Its org, tnear, dir, time (0) and tfar come from load().
+// flags 0. Its org, tnear, dir, time (0) and tfar are written per ray by load().
 RTCRay batch_ray() {
   RTCRay r;
   r.time = 0.0f;
@@ -333,7 +359,7 @@ class EmbreeBackend final : public Backend {
   // What Embree selected for this backend's config (the probe: a second
   // device, one triangle, committed once) and the library it runs; computed
   // on the first call, never in a timed loop. Fields the probe cannot read
-  // are "unknown"; it never fails.
+  // are "unknown"; it throws only if stdout cannot be restored (capture_stdout).
   std::vector<std::pair<std::string, std::string>> provenance() const override {
     if (!selection_) selection_ = probe_selection(device_config_, options_);
     const EmbreeLibrary& library = embree_library();

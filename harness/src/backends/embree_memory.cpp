@@ -1,16 +1,10 @@
 // Embree 3's memory policy through its device config (embree_memory.h).
-// Embree 3.13's FastAllocator (kernels/common/alloc.h) takes its tree's memory
-// in main blocks of min(growSize, maxGrowSize) bytes, maxGrowSize being a
-// twentieth of the estimated tree, at most maxAllocationSize = 2 MiB - 64.
-// Blocks below that go to alignedMalloc (no huge-page advice); blocks of
-// exactly that size, in a static scene, go to os_malloc, which tries
-// MAP_HUGETLB (with `hugepages=1`) and else mmaps and advises MADV_HUGEPAGE.
-// So by default only trees estimated above ~40 MiB get huge pages, and
-// `alloc_main_block_size` cannot help: it sets growSize, which maxGrowSize
-// caps. What routes every block to os_malloc is a thread block of exactly
-// maxAllocationSize: each thread-local refill then asks for a whole main
-// block of that size. Measured (AnonHugePages before and after a build, the
-// sizes per scene): docs/notes/memory-policy.md.
+// What: "on" sets a thread block of exactly Embree 3.13's maxAllocationSize,
+// which routes every block of its tree through its advised os_malloc; "off"
+// keeps its main blocks below that size, so none is advised.
+// Why: only blocks of exactly that size reach os_malloc (by default only
+// trees above ~40 MiB); Embree's allocator and the measurements:
+// docs/notes/memory-policy.md.
 #include "backends/embree_memory.h"
 
 #include <cstddef>

@@ -457,8 +457,19 @@ std::vector<std::string> backends_for_scene(const std::vector<std::string>& name
   return runnable;
 }
 
-std::string memory_policy_description(bool huge_pages) {
-  return huge_pages ? "huge pages for every backend (transparent, madvise)" : "ordinary pages for every backend";
+std::string memory_policy_description(bool huge_pages, std::string_view thp_mode) {
+  if (thp_mode == "always")
+    return huge_pages ? "huge pages for every backend (transparent, the kernel's THP mode 'always')"
+                      : "ordinary pages requested for every backend, but the kernel's THP mode 'always' may give any "
+                        "of them huge pages";
+  if (thp_mode == "never")
+    return huge_pages ? "huge pages requested for every backend, but the kernel's THP mode 'never' gives none of them "
+                        "huge pages"
+                      : "ordinary pages for every backend";
+  if (thp_mode == "madvise")
+    return huge_pages ? "huge pages for every backend (transparent, madvise)" : "ordinary pages for every backend";
+  return huge_pages ? "huge pages requested for every backend (transparent, madvise); the kernel's THP mode is unknown"
+                    : "ordinary pages requested for every backend; the kernel's THP mode is unknown";
 }
 
 std::string timing_reference(const SuiteSettings& settings) {
@@ -567,6 +578,7 @@ RunResults run_loaded_scenes(const RunOptions& options, const RunChecks& checks,
 
   std::vector<std::string> scene_names;
   for (const auto& s : scenes) scene_names.push_back(s.scene.name);
+  const std::string thp_mode = transparent_huge_pages_mode();
   Metadata run_description = {
       {"command", options.command_line},
       {"suite", options.suite.path},
@@ -583,8 +595,8 @@ RunResults run_loaded_scenes(const RunOptions& options, const RunChecks& checks,
       {"timing", "rounds"},
       {"reference_backend", reference},
       {"agreement_backend", kAgreementBackend},
-      {"memory_policy", memory_policy_description(settings.huge_pages)},
-      {"thp", transparent_huge_pages_mode()},
+      {"memory_policy", memory_policy_description(settings.huge_pages, thp_mode)},
+      {"thp", thp_mode},
   };
   std::vector<std::string> tessellate;
   for (const Tessellation& t : settings.tessellate) tessellate.push_back(t.spec());

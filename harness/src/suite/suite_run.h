@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "accuracy/accuracy_csv.h"
@@ -47,11 +48,15 @@ inline constexpr const char* kDefaultTimingReference = "embree";
 // else "" (none).
 std::string timing_reference(const SuiteSettings& settings);
 
-// The run's memory policy as its metadata records it (memory_policy = ...):
-// "huge pages for every backend (transparent, madvise)" or "ordinary pages
-// for every backend". Beside it, thp = the kernel's THP mode
-// (measure/page_residency.h), which decides whether advice is followed.
-std::string memory_policy_description(bool huge_pages);
+// The run's memory policy as its metadata records it (memory_policy = ...),
+// given the kernel's THP mode (measure/page_residency.h; recorded beside it
+// as thp), which decides what the policy can do: under "madvise" it holds
+// ("huge pages for every backend (transparent, madvise)" or "ordinary pages
+// for every backend"); under "always" nothing is advised off huge pages (and
+// Embree's memory cannot be), so "off" only requests ordinary pages; under
+// "never" no backend gets huge pages; any other mode ("unavailable") says the
+// mode is unknown.
+std::string memory_policy_description(bool huge_pages, std::string_view thp_mode);
 
 // A backend a run did not trace on a scene because the scene has a primitive
 // type the backend's capabilities() lack (plugins: anything not a triangle).

@@ -47,8 +47,8 @@ inline bool huge_pages_enabled() noexcept {
 // bytes >= kHugePageBytes on, a fresh huge-page-aligned mapping, advised as
 // huge pages while huge_pages_enabled(). Fresh, not from the heap: memory
 // the heap hands out again was faulted in as small pages before, and stays
-// so whatever the advice (a run's second scene had 0 of bvh8's 4.4 MiB in
-// huge pages: docs/notes/memory-policy.md); Embree's os_malloc maps afresh too.
+// so whatever the advice (measured: docs/notes/memory-policy.md); Embree's
+// os_malloc maps afresh too.
 // Release with free_huge_pages(p, bytes) with the same bytes.
 inline void* allocate_huge_pages(std::size_t bytes, std::size_t alignment) {
   if (bytes < kHugePageBytes) return ::operator new(bytes, std::align_val_t(alignment));

@@ -12,8 +12,7 @@
 // With AVX-512F and VL (raybench::simd::kHaveAvx512; chosen at compile time,
 // -march=native on such a host) the same widths gain comparisons into a lane
 // mask (vcmpps k, chained under a mask for an and), for the leaf tests; they
-// answer bit for bit as compare-and-movemask. Where AVX-512 did not pay (the
-// node test, in-register compression for the ordered push) and what did:
+// answer bit for bit as compare-and-movemask. What AVX-512 paid and did not:
 // docs/notes/kernels-wide-traversal.md
 #pragma once
 
