@@ -112,15 +112,17 @@ TEST(Screening, TheAnswersOfScreenedRaysAreForcedToMissesAndNoOtherAnswerChanges
 }
 
 // Screening is outside the backends: every built-in backend answers the
-// screened-out rays (kEmptyRay) as misses itself, and those of our own BVHs,
-// which also tolerate rays as stored, answer the screened rays exactly as the
-// stored ones, on every ray set that needs no inside ball, the extreme ones
-// (NaN and Inf, behind the origin, axis-parallel, huge and tiny directions,
-// far origins) included. Embree is handed screened rays only (backend.h:
-// Debian's assert-enabled Embree aborts on NaN, Inf and a negative tnear).
+// screened-out rays (kEmptyRay) as misses itself, on every ray set that needs
+// no inside ball, the extreme ones (NaN and Inf, behind the origin,
+// axis-parallel, huge and tiny directions, far origins) included. Backends
+// trace screened rays only (backend.h: Embree aborts on NaN, Inf and a
+// negative tnear; our timed loops trace each ray as given, doing no more
+// per-ray work than Embree's); our own are also handed the rays as stored,
+// which must not crash them (the sanitized build checks that), whatever
+// they answer.
 class EveryBuiltInBackend : public ::testing::TestWithParam<std::string> {};
 
-TEST_P(EveryBuiltInBackend, AnswersTheScreenedRaysAsItAnsweredTheStoredOnes) {
+TEST_P(EveryBuiltInBackend, AnswersTheScreenedOutRaysAsMisses) {
   const Scene scene = load_scene("proc:sphere");
   const auto backend = make_backend(GetParam());
   backend->build(scene);
@@ -132,30 +134,18 @@ TEST_P(EveryBuiltInBackend, AnswersTheScreenedRaysAsItAnsweredTheStoredOnes) {
     const std::vector<Ray> rays = generator.generate(RaySetSpec{kind, 600, 7, std::nullopt, std::nullopt, std::nullopt});
     const ScreenedRays s = screen_rays(rays);
     untraceable += static_cast<int>(s.screened.size());
-    std::vector<Hit> stored(rays.size()), screened(rays.size());
-    std::vector<std::uint8_t> stored_occ(rays.size()), screened_occ(rays.size());
+    std::vector<Hit> screened(rays.size());
+    std::vector<std::uint8_t> screened_occ(rays.size());
     backend->intersect(s.rays, screened);
     backend->occluded(s.rays, screened_occ);
     for (const std::size_t i : s.screened) {
       ASSERT_FALSE(screened[i].hit() || screened_occ[i]) << name << " ray " << i << ", screened out";
     }
-    force_misses(s, screened);
-    force_misses(s, screened_occ);
     if (GetParam().rfind("embree", 0) == 0) continue;  // screened rays only
+    std::vector<Hit> stored(rays.size());
+    std::vector<std::uint8_t> stored_occ(rays.size());
     backend->intersect(rays, stored);
     backend->occluded(rays, stored_occ);
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-      ASSERT_EQ(stored[i].prim, screened[i].prim) << name << " ray " << i;
-      if (stored[i].hit()) {
-        ASSERT_EQ(stored[i].t, screened[i].t) << name << " ray " << i;
-        ASSERT_EQ(stored[i].u, screened[i].u) << name << " ray " << i;
-        ASSERT_EQ(stored[i].v, screened[i].v) << name << " ray " << i;
-      }
-      ASSERT_EQ(stored_occ[i], screened_occ[i]) << name << " ray " << i;
-      if (!is_traceable(rays[i])) {
-        ASSERT_FALSE(stored[i].hit() || stored_occ[i]) << name << " ray " << i;
-      }
-    }
   }
   EXPECT_GT(untraceable, 0) << "the invalid ray set (G15) has NaN and Inf rays";
 }

@@ -76,12 +76,11 @@ class Backend {
   // - the interval (tnear, tfar] may be empty (tfar < tnear, -inf included;
   //   kEmptyRay stands for a ray screened out): such a ray is a miss and not
   //   occluded.
-  // Embree requires screened rays (Debian's, built with assertions, aborts on
-  // NaN, Inf or a negative tnear), and plugins are promised them
-  // (docs/plugins.md). Our built-in backends take unscreened rays as well:
-  // they answer an untraceable ray (is_traceable, math/ray.h) as a miss, not
-  // occluded, and raise a negative tnear to 0 per ray, as screening would
-  // (tests/mixed_backend_test.cpp hands them such rays on purpose).
+  // Every backend relies on it: Embree (Debian's, built with assertions,
+  // aborts on NaN, Inf or a negative tnear), plugins (docs/plugins.md), and
+  // our own, whose timed loops trace each ray as given, so that every
+  // backend does the same per-ray work inside the timing (issue 33). An
+  // unscreened ray's answer is undefined (still no crash for our own).
 
   // Closest hit for every ray (t, prim, u, v; a miss is the default Hit).
   // Called concurrently on disjoint chunks, so implementations are const

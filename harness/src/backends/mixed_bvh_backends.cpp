@@ -56,12 +56,12 @@ class MixedBvh2Backend final : public Backend {
 
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
     for (std::size_t i = 0; i < rays.size(); ++i)
-      hits[i] = is_traceable(rays[i]) ? intersect_mixed_bvh2<Test, BoxTest>(bvh_, with_nonnegative_tnear(rays[i])) : Hit{};
+      hits[i] = intersect_mixed_bvh2<Test, BoxTest>(bvh_, rays[i]);  // screened rays (backend.h)
   }
 
   void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override {
     for (std::size_t i = 0; i < rays.size(); ++i)
-      occluded[i] = is_traceable(rays[i]) && occluded_mixed_bvh2<Test, BoxTest>(bvh_, with_nonnegative_tnear(rays[i]));
+      occluded[i] = occluded_mixed_bvh2<Test, BoxTest>(bvh_, rays[i]);
   }
 
  private:
