@@ -238,7 +238,8 @@ def summary(meta, lines, evaluated, source):
             "bvh8_geomean": None if bvh8_mean is None else round(bvh8_mean, 2),
             "met": sum(t["status"] == "met" for t in evaluated), "targets": len(evaluated),
             "missing_scenes": len(missing_suite_scenes(meta)),
-            "not_measurable": sum(t["status"] == "not measurable" for t in evaluated)}
+            "not_measurable": sum(t["status"] == "not measurable" for t in evaluated),
+            "old_embree_loop": not embree_provenance(meta)}
 
 
 DEFAULT_SUITE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "meshes", "default.toml")
@@ -345,6 +346,8 @@ def index_lines(directory, link_prefix=""):
         unmeasurable = f", {f['not_measurable']} not measurable" if f.get("not_measurable") else ""
         if f.get("missing_scenes"):
             unmeasurable += f"; the run lacks {f['missing_scenes']} of today's default-suite scenes"
+        if f.get("old_embree_loop"):
+            unmeasurable += "; measured before issue 33's Embree wrapper fix (its ratios overstate ours)"
         fmt = lambda v: "-" if v is None else f"{v:.2f}"  # noqa: E731
         out.append(f"| [{f['class']}]({link_prefix}{name}) | {f['cpu']} | {f['isa']} | {f['date']} | `{f['commit']}` | "
                    f"{fmt(f['best_geomean'])} | {fmt(f['bvh8_geomean'])} | {f['met']} of {f['targets']}{unmeasurable} |")
