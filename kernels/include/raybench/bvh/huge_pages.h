@@ -28,6 +28,12 @@ namespace raybench {
 
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 
+// `bytes` rounded up to whole huge pages: what allocate_huge_pages maps and
+// free_huge_pages unmaps for an array of kHugePageBytes or more.
+inline constexpr std::size_t huge_page_rounded(std::size_t bytes) {
+  return (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
+}
+
 namespace huge_pages_detail {
 inline std::atomic<bool> advise_huge_pages{true};
 }  // namespace huge_pages_detail
@@ -52,7 +58,7 @@ inline bool huge_pages_enabled() noexcept {
 // Release with free_huge_pages(p, bytes) with the same bytes.
 inline void* allocate_huge_pages(std::size_t bytes, std::size_t alignment) {
   if (bytes < kHugePageBytes) return ::operator new(bytes, std::align_val_t(alignment));
-  const std::size_t rounded = (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
+  const std::size_t rounded = huge_page_rounded(bytes);
 #if defined(__linux__)
   // One huge page more than needed, then the slack on either side unmapped.
   const std::size_t mapped = rounded + kHugePageBytes;
@@ -80,7 +86,7 @@ inline void free_huge_pages(void* p, std::size_t bytes, std::size_t alignment) {
     return;
   }
 #if defined(__linux__)
-  munmap(p, (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes);
+  munmap(p, huge_page_rounded(bytes));
 #else
   std::free(p);
 #endif

@@ -81,15 +81,9 @@ struct FloatLanes<8> {
   FloatLanes permute(IntLanes<8> index) const { return {_mm256_permutevar8x32_ps(v, index.v)}; }
   unsigned mask() const { return static_cast<unsigned>(_mm256_movemask_ps(v)); }
 #if defined(RAYBENCH_AVX512)
-  // Bit i set when lane i compares true and bit i of `within` is set: one
-  // compare into a mask register (the and comes free), same predicates as
-  // the operators above.
-  unsigned le_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_LE_OQ>(o, within); }
-  unsigned lt_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_LT_OQ>(o, within); }
-  unsigned ge_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_GE_OQ>(o, within); }
-  unsigned gt_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_GT_OQ>(o, within); }
-  unsigned eq_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_EQ_OQ>(o, within); }
-  unsigned ne_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_NEQ_OQ>(o, within); }
+  // Bit i set when lane i compares true by `Predicate` and bit i of `within`
+  // is set: one compare into a mask register (the and comes free). The
+  // named forms, for every width, follow the specialisations (le_mask, ...).
   template <int Predicate>
   unsigned cmp_mask(FloatLanes o, unsigned within) const {
     return _mm256_mask_cmp_ps_mask(static_cast<__mmask8>(within), v, o.v, Predicate);
@@ -142,21 +136,29 @@ struct FloatLanes<4> {
   FloatLanes permute(IntLanes<4> index) const { return {_mm_permutevar_ps(v, index.v)}; }
   unsigned mask() const { return static_cast<unsigned>(_mm_movemask_ps(v)); }
 #if defined(RAYBENCH_AVX512)
-  // Bit i set when lane i compares true and bit i of `within` is set: one
-  // compare into a mask register (the and comes free), same predicates as
-  // the operators above.
-  unsigned le_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_LE_OQ>(o, within); }
-  unsigned lt_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_LT_OQ>(o, within); }
-  unsigned ge_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_GE_OQ>(o, within); }
-  unsigned gt_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_GT_OQ>(o, within); }
-  unsigned eq_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_EQ_OQ>(o, within); }
-  unsigned ne_mask(FloatLanes o, unsigned within = 0xff) const { return cmp_mask<_CMP_NEQ_OQ>(o, within); }
+  // Bit i set when lane i compares true by `Predicate` and bit i of `within`
+  // is set: one compare into a mask register (the and comes free). The
+  // named forms, for every width, follow the specialisations (le_mask, ...).
   template <int Predicate>
   unsigned cmp_mask(FloatLanes o, unsigned within) const {
     return _mm_mask_cmp_ps_mask(static_cast<__mmask8>(within), v, o.v, Predicate);
   }
 #endif
 };
+#if defined(RAYBENCH_AVX512)
+// a <= b (and so on) in the lanes of `within`, as a lane mask: the same
+// ordered, non-signalling predicates as the operators above, for the widths
+// that have cmp_mask.
+template <int W>
+unsigned le_mask(FloatLanes<W> a, FloatLanes<W> b, unsigned within = 0xff) { return a.template cmp_mask<_CMP_LE_OQ>(b, within); }
+template <int W>
+unsigned ge_mask(FloatLanes<W> a, FloatLanes<W> b, unsigned within = 0xff) { return a.template cmp_mask<_CMP_GE_OQ>(b, within); }
+template <int W>
+unsigned gt_mask(FloatLanes<W> a, FloatLanes<W> b, unsigned within = 0xff) { return a.template cmp_mask<_CMP_GT_OQ>(b, within); }
+template <int W>
+unsigned ne_mask(FloatLanes<W> a, FloatLanes<W> b, unsigned within = 0xff) { return a.template cmp_mask<_CMP_NEQ_OQ>(b, within); }
+#endif
+
 inline FloatLanes<4> max(FloatLanes<4> a, FloatLanes<4> b) { return {_mm_max_ps(a.v, b.v)}; }
 inline FloatLanes<4> min(FloatLanes<4> a, FloatLanes<4> b) { return {_mm_min_ps(a.v, b.v)}; }
 // a * b + c, rounded once (std::fma).

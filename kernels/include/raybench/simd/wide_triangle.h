@@ -150,12 +150,13 @@ RAYBENCH_INLINE int intersect_pack_simd(const Ray& ray, float tmax, const Pack& 
   const F tnear = F::set1(ray.tnear);
 #if defined(RAYBENCH_AVX512)
   // The same five comparisons chained under masks: each ands the last.
-  const unsigned ok = (t_scaled.gt_mask(abs_det * tnear, (u_scaled + v_scaled).le_mask(
-                          abs_det, v_scaled.ge_mask(zero, u_scaled.ge_mask(zero, det.ne_mask(zero))))));
+  const unsigned ok = gt_mask(t_scaled, abs_det * tnear,
+                              le_mask(u_scaled + v_scaled, abs_det,
+                                      ge_mask(v_scaled, zero, ge_mask(u_scaled, zero, ne_mask(det, zero)))));
   if (!ok) return -1;  // most packs: no division
   const F inv_det = F::set1(1.0f) / abs_det;
   const F tt = t_scaled * inv_det;
-  unsigned mask = tt.le_mask(F::set1(tmax), tt.gt_mask(tnear, ok));
+  unsigned mask = le_mask(tt, F::set1(tmax), gt_mask(tt, tnear, ok));
 #else
   const F ok = (det != zero) & (u_scaled >= zero) & (v_scaled >= zero) & (u_scaled + v_scaled <= abs_det) &
                (t_scaled > abs_det * tnear);
