@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <map>
 #include <set>
 
 #include "io/error.h"
@@ -43,7 +44,7 @@ TEST_P(RaySets, AreDeterministicForTheSameSpecAndDifferForAnotherSeed) {
 
 INSTANTIATE_TEST_SUITE_P(AllButMustHit, RaySets,
                          ::testing::Values(RaySetKind::kPrimary, RaySetKind::kDiffuse, RaySetKind::kShadow,
-                                           RaySetKind::kUniform, RaySetKind::kTinyTriangles, RaySetKind::kGrazing, RaySetKind::kDegenerateTriangles,
+                                           RaySetKind::kUniform, RaySetKind::kPrimaryTiled, RaySetKind::kTinyTriangles, RaySetKind::kGrazing, RaySetKind::kDegenerateTriangles,
                                            RaySetKind::kAxisParallel, RaySetKind::kBehindOrigin, RaySetKind::kInvalid,
                                            RaySetKind::kDirectionScaling, RaySetKind::kBvhConservative,
                                            RaySetKind::kReintersection, RaySetKind::kControlRandom, RaySetKind::kFarOrigin),
@@ -68,8 +69,12 @@ TEST_P(OrdinaryRaySets, HaveUnitDirectionsAndValidIntervals) {
 
 INSTANTIATE_TEST_SUITE_P(AllKinds, OrdinaryRaySets,
                          ::testing::Values(RaySetKind::kPrimary, RaySetKind::kDiffuse, RaySetKind::kShadow,
-                                           RaySetKind::kUniform),
-                         [](const auto& info) { return to_string(info.param); });
+                                           RaySetKind::kUniform, RaySetKind::kPrimaryTiled, RaySetKind::kShadowTiled),
+                         [](const auto& info) {
+                           std::string name = to_string(info.param);
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
 
 TEST(ExtremeRaySets, AxisParallelRaysHaveSignedZerosAndOriginsOnTheTargetsSlabPlanes) {
   const Scene boxes = load_scene("proc:axis_boxes");
@@ -249,7 +254,8 @@ TEST(RaySets, KindNamesRoundTripAndUnknownNamesAreErrors) {
 // Triangle scenes keep their rays (stored ray sets and results rely on it):
 // fingerprints of every kind on proc:terrain_spheres_small (seed 5, 3000
 // rays) and of the must-hit kinds on proc:sphere, as generator version 3
-// made them before scenes had analytic primitives.
+// made them before scenes had analytic primitives. primary-tiled and
+// shadow-tiled came later (issue 32) as new kinds under the same version.
 
 std::uint64_t fingerprint(const std::vector<Ray>& rays) {
   std::uint64_t h = rays.size();
@@ -270,6 +276,8 @@ TEST(RaySets, TriangleScenesKeepTheRaysOfGeneratorVersion3) {
       {"diffuse", 0xcc53f701ec99c072u},
       {"shadow", 0xc816c8ed7f992e6fu},
       {"uniform", 0xfb3f77a1b9d18adeu},
+      {"primary-tiled", 0x575c2eb29628fe42u},
+      {"shadow-tiled", 0x78782f4d3a14fcc3u},
       {"tiny-triangles", 0x58f787ed78fb9690u},
       {"grazing", 0x09a1aa93385cd167u},
       {"degenerate-triangles", 0x66a19b95ffe47f77u},
@@ -397,7 +405,7 @@ TEST_P(AnalyticRaySets, WorkWithoutTrianglesAndMixedAreDeterministicAndAimAtEver
 
 INSTANTIATE_TEST_SUITE_P(AllButMustHit, AnalyticRaySets,
                          ::testing::Values(RaySetKind::kPrimary, RaySetKind::kDiffuse, RaySetKind::kShadow,
-                                           RaySetKind::kUniform, RaySetKind::kTinyTriangles, RaySetKind::kGrazing, RaySetKind::kDegenerateTriangles,
+                                           RaySetKind::kUniform, RaySetKind::kPrimaryTiled, RaySetKind::kTinyTriangles, RaySetKind::kGrazing, RaySetKind::kDegenerateTriangles,
                                            RaySetKind::kAxisParallel, RaySetKind::kBehindOrigin, RaySetKind::kInvalid,
                                            RaySetKind::kDirectionScaling, RaySetKind::kBvhConservative,
                                            RaySetKind::kReintersection, RaySetKind::kControlRandom, RaySetKind::kFarOrigin),
@@ -412,7 +420,7 @@ TEST(AnalyticRaySets, SecondaryRaysStartOnTheirSourceAndNeverHitItAgain) {
     const RayGenerator gen(scene);
     const Referee referee(scene);
     const PrimitiveSpans prims = scene.primitives();
-    for (RaySetKind kind : {RaySetKind::kDiffuse, RaySetKind::kShadow, RaySetKind::kReintersection}) {
+    for (RaySetKind kind : {RaySetKind::kDiffuse, RaySetKind::kShadow, RaySetKind::kShadowTiled, RaySetKind::kReintersection}) {
       std::vector<std::int32_t> sources;
       const std::vector<Ray> rays = gen.generate({kind, 2000, 3, std::nullopt, std::nullopt}, &sources);
       ASSERT_EQ(sources.size(), rays.size());
@@ -606,6 +614,191 @@ TEST(AnalyticTargets, SurfacePointsCornersAndEdgesLieWhereTheySay) {
   }
   EXPECT_DOUBLE_EQ(primitive_size(prims, 0), 1.0);
   EXPECT_NEAR(primitive_size(prims, 1), std::sqrt(16.0 + 0.5625 + 0.25), 1e-12);
+}
+
+
+// ---------------------------------------------------------------------------
+// The coherent orders (issue 32): primary-tiled is primary's pixels in 8x8
+// screen tiles of 4x2 blocks, shadow-tiled one shadow ray per hit of them.
+
+using Bits = std::array<std::uint32_t, 8>;
+Bits bits_of(const Ray& r) {
+  Bits b;
+  std::memcpy(b.data(), &r, sizeof(Ray));
+  return b;
+}
+
+// For every primary-tiled ray, the scanline index of the identical primary
+// ray; fails the test unless primary-tiled is a permutation of primary.
+std::vector<std::size_t> scanline_indices_of_tiled(std::size_t count, std::uint64_t seed = 1) {
+  const RayGenerator gen(test_scene());
+  const std::vector<Ray> scanline = gen.generate({RaySetKind::kPrimary, count, seed, std::nullopt, std::nullopt});
+  const std::vector<Ray> tiled = gen.generate({RaySetKind::kPrimaryTiled, count, seed, std::nullopt, std::nullopt});
+  EXPECT_EQ(tiled.size(), scanline.size());
+  std::map<Bits, std::size_t> index;
+  for (std::size_t i = 0; i < scanline.size(); ++i) index.emplace(bits_of(scanline[i]), i);
+  EXPECT_EQ(index.size(), scanline.size()) << "primary rays are all distinct";
+  std::vector<std::size_t> out;
+  std::set<std::size_t> seen;
+  for (const Ray& r : tiled) {
+    const auto it = index.find(bits_of(r));
+    if (it == index.end()) {
+      ADD_FAILURE() << "a primary-tiled ray that is not a primary ray";
+      return {};
+    }
+    EXPECT_TRUE(seen.insert(it->second).second) << "pixel " << it->second << " twice";
+    out.push_back(it->second);
+  }
+  return out;
+}
+
+// The grid primary uses: W = ceil(sqrt(N * aspect)), with the camera's float
+// aspect (4/3 rounded up: 1728 rays make 49 columns, not 48).
+std::size_t grid_width(std::size_t count) {
+  return static_cast<std::size_t>(std::ceil(std::sqrt(count * static_cast<double>(Camera{}.aspect))));
+}
+
+TEST(TiledRaySets, PrimaryTiledIsAPermutationOfPrimaryBitForBit) {
+  for (std::size_t count : {std::size_t{1}, std::size_t{7}, std::size_t{1000}, std::size_t{1728}, std::size_t{3001}}) {
+    SCOPED_TRACE(count);
+    EXPECT_EQ(scanline_indices_of_tiled(count).size(), count);
+  }
+  EXPECT_TRUE(RayGenerator(test_scene()).generate({RaySetKind::kPrimaryTiled, 0, 1, std::nullopt, std::nullopt}).empty());
+}
+
+TEST(TiledRaySets, EightRaysAre4x2Blocks16Are4x4And32AreHalfTiles64ATile) {
+  // 1700 rays: a 48 x 36 grid, W a multiple of 8.
+  const std::size_t width = grid_width(1700);
+  ASSERT_EQ(width, 48u);
+  const std::vector<std::size_t> order = scanline_indices_of_tiled(1700);
+  ASSERT_EQ(order.size(), 1700u);
+  // Every group of m consecutive rays in the first two tiles fills an
+  // aligned w x h rectangle of pixels.
+  const struct { std::size_t rays, w, h; } groups[] = {{8, 4, 2}, {16, 4, 4}, {32, 8, 4}, {64, 8, 8}};
+  for (const auto& g : groups) {
+    for (std::size_t first = 0; first < 128; first += g.rays) {
+      std::size_t x0 = SIZE_MAX, y0 = SIZE_MAX, x1 = 0, y1 = 0;
+      for (std::size_t k = first; k < first + g.rays; ++k) {
+        x0 = std::min(x0, order[k] % width), x1 = std::max(x1, order[k] % width);
+        y0 = std::min(y0, order[k] / width), y1 = std::max(y1, order[k] / width);
+      }
+      EXPECT_EQ(x1 - x0 + 1, g.w) << "rays " << first << ".." << first + g.rays - 1;
+      EXPECT_EQ(y1 - y0 + 1, g.h) << "rays " << first << ".." << first + g.rays - 1;
+      EXPECT_EQ(x0 % g.w, 0u);
+      EXPECT_EQ(y0 % g.h, 0u);
+    }
+  }
+  // A 4x2 block is two rows of four, left to right; then the block below it
+  // (a 4x4 block); then the two to its right; then the lower half tile.
+  const std::size_t first_block[8] = {0, 1, 2, 3, width, width + 1, width + 2, width + 3};
+  for (std::size_t k = 0; k < 8; ++k) EXPECT_EQ(order[k], first_block[k]);
+  EXPECT_EQ(order[8], 2 * width);
+  EXPECT_EQ(order[16], 4u);
+  EXPECT_EQ(order[32], 4 * width);
+  // Tiles in scanline order: the second tile is to the right of the first,
+  // the seventh (48 / 8 = 6 per row) starts the second row of tiles.
+  EXPECT_EQ(order[64], 8u);
+  EXPECT_EQ(order[6 * 64], 8 * width);
+}
+
+// The rank of pixel (x, y) in tile order: tiles in scanline order, then the
+// position k inside the tile, whose bits give x = k0 + 2 k1 + 4 k4 and
+// y = k2 + 2 k3 + 4 k5 (docs/raysets.md).
+std::pair<std::size_t, std::size_t> tile_rank(std::size_t x, std::size_t y, std::size_t width) {
+  const std::size_t tiles_per_row = (width + 7) / 8;
+  const std::size_t tile = (y / 8) * tiles_per_row + x / 8;
+  const std::size_t lx = x % 8, ly = y % 8;
+  const std::size_t k = (lx & 1) | (lx >> 1 & 1) << 1 | (ly & 1) << 2 | (ly >> 1 & 1) << 3 | (lx >> 2 & 1) << 4 | (ly >> 2 & 1) << 5;
+  return {tile, k};
+}
+
+TEST(TiledRaySets, PartialTilesAndThePartialLastRowKeepTheOrderAndSkipMissingPixels) {
+  // 1000 rays: a 37 x 28 grid (the right column of tiles 5 wide, the bottom
+  // row of tiles 4 tall) whose last row holds a single pixel.
+  const std::size_t width = grid_width(1000);
+  ASSERT_EQ(width, 37u);
+  const std::vector<std::size_t> order = scanline_indices_of_tiled(1000);
+  ASSERT_EQ(order.size(), 1000u);
+  for (std::size_t k = 1; k < order.size(); ++k)
+    ASSERT_LT(tile_rank(order[k - 1] % width, order[k - 1] / width, width), tile_rank(order[k] % width, order[k] / width, width))
+        << "rays " << k - 1 << " and " << k;
+  // The last tile with pixels is the bottom-right one: rows 24..26, x 32..36
+  // (row 27 has only x = 0, in the first tile of its row).
+  for (std::size_t k = 1000 - 15; k < 1000; ++k) {
+    EXPECT_GE(order[k] % width, 32u);
+    EXPECT_GE(order[k] / width, 24u);
+  }
+  EXPECT_EQ(std::count(order.begin(), order.end(), 999u), 1);
+}
+
+TEST(TiledRaySets, ShadowTiledHasOneShadowRayPerPrimaryTiledHitInTheSameOrder) {
+  const Scene& scene = test_scene();
+  const Vec3f light{5, 50, -5};
+  const RayGenerator gen(scene);
+  const std::vector<Ray> pixels = gen.generate({RaySetKind::kPrimaryTiled, 3000, 2, std::nullopt, light});
+  std::vector<std::int32_t> sources;
+  const std::vector<Ray> shadow = gen.generate({RaySetKind::kShadowTiled, 3000, 2, std::nullopt, light}, &sources);
+  ASSERT_EQ(sources.size(), shadow.size());
+  // Our own primary hits, as the generator finds them (BVH2, Möller-Trumbore).
+  const Bvh2 bvh = build_bvh2_binned_sah(scene.triangles);
+  std::vector<MollerTrumbore::Prepared> prepared;
+  for (std::uint32_t id : bvh.prim_ids) prepared.push_back(MollerTrumbore::prepare(scene.triangles[id]));
+  std::size_t next = 0, misses = 0;
+  for (const Ray& pixel : pixels) {
+    const Hit h = intersect_bvh2<MollerTrumbore>(bvh, prepared, pixel);
+    if (!h.hit()) {
+      ++misses;
+      continue;
+    }
+    ASSERT_LT(next, shadow.size());
+    const Ray& r = shadow[next];
+    EXPECT_EQ(sources[next], h.prim) << "shadow ray " << next;
+    // It starts at the hit (but for the offset) and ends at the light.
+    const Vec3f at = pixel.org + pixel.dir * h.t;
+    EXPECT_LT(length(r.org - at), 1e-3f * std::max(1.0f, length(at))) << "shadow ray " << next;
+    const Vec3f end = r.org + r.dir * r.tfar;
+    EXPECT_NEAR(length(end - light), 0.0f, 1e-3f) << "shadow ray " << next;
+    ++next;
+  }
+  EXPECT_EQ(next, shadow.size());
+  // The default camera sees the sky too: those pixels make no shadow ray.
+  EXPECT_GT(misses, 0u);
+  EXPECT_EQ(shadow.size(), pixels.size() - misses);
+}
+
+TEST(TiledRaySets, ShadowTiledIsDeterministicAndHasItsOwnKey) {
+  const RayGenerator gen(test_scene());
+  const RaySetSpec spec{RaySetKind::kShadowTiled, 2000, 7, std::nullopt, std::nullopt};
+  const std::vector<Ray> a = gen.generate(spec);
+  EXPECT_TRUE(identical(a, RayGenerator(test_scene()).generate(spec)));
+  RaySetSpec other = spec;
+  other.seed = 8;
+  EXPECT_FALSE(identical(a, gen.generate(other)));
+  for (RaySetKind kind : {RaySetKind::kShadow, RaySetKind::kPrimaryTiled, RaySetKind::kPrimary}) {
+    RaySetSpec another = spec;
+    another.kind = kind;
+    EXPECT_NE(gen.key(spec), gen.key(another)) << to_string(kind);
+  }
+}
+
+TEST(TiledRaySets, ShadowTiledFromACameraThatSeesNothingIsAnError) {
+  Camera away;
+  away.position = {0, 1000, 0};
+  away.look_at = {0, 2000, 0};
+  away.up = {1, 0, 0};
+  EXPECT_THROW(RayGenerator(test_scene()).generate({RaySetKind::kShadowTiled, 100, 1, away, std::nullopt}), InputError);
+}
+
+TEST(TiledRaySets, QueriesSourcesAndCounts) {
+  EXPECT_EQ(query_of(RaySetKind::kPrimaryTiled), Query::kIntersect);
+  EXPECT_EQ(query_of(RaySetKind::kShadowTiled), Query::kOccluded);
+  EXPECT_FALSE(has_sources(RaySetKind::kPrimaryTiled));
+  EXPECT_TRUE(has_sources(RaySetKind::kShadowTiled));
+  EXPECT_TRUE(has_exact_count(RaySetKind::kPrimaryTiled));
+  EXPECT_FALSE(has_exact_count(RaySetKind::kShadowTiled));
+  EXPECT_TRUE(has_exact_count(RaySetKind::kShadow));
+  EXPECT_EQ(parse_rayset_kind("primary-tiled"), RaySetKind::kPrimaryTiled);
+  EXPECT_EQ(parse_rayset_kind("shadow-tiled"), RaySetKind::kShadowTiled);
 }
 
 }  // namespace

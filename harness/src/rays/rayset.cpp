@@ -72,6 +72,7 @@ Eigen::Vector3d uniform_direction(Rng& rng) {
 
 constexpr RaySetKind kAllKinds[] = {
     RaySetKind::kPrimary,          RaySetKind::kDiffuse,         RaySetKind::kShadow,          RaySetKind::kUniform,
+    RaySetKind::kPrimaryTiled,     RaySetKind::kShadowTiled,
     RaySetKind::kClosedInsideRandom, RaySetKind::kSharedEdgeAimed, RaySetKind::kVertexAimed,   RaySetKind::kTinyTriangles,
     RaySetKind::kGrazing,          RaySetKind::kDegenerateTriangles, RaySetKind::kAxisParallel, RaySetKind::kBehindOrigin,
     RaySetKind::kInvalid,          RaySetKind::kDirectionScaling, RaySetKind::kBvhConservative, RaySetKind::kReintersection,
@@ -83,6 +84,8 @@ std::string to_string(RaySetKind kind) {
     case RaySetKind::kDiffuse: return "diffuse";
     case RaySetKind::kShadow: return "shadow";
     case RaySetKind::kUniform: return "uniform";
+    case RaySetKind::kPrimaryTiled: return "primary-tiled";
+    case RaySetKind::kShadowTiled: return "shadow-tiled";
     case RaySetKind::kClosedInsideRandom: return "closed-inside-random";
     case RaySetKind::kSharedEdgeAimed: return "shared-edge-aimed";
     case RaySetKind::kVertexAimed: return "vertex-aimed";
@@ -106,8 +109,11 @@ bool is_must_hit(RaySetKind kind) {
 }
 
 bool has_sources(RaySetKind kind) {
-  return kind == RaySetKind::kDiffuse || kind == RaySetKind::kShadow || kind == RaySetKind::kReintersection;
+  return kind == RaySetKind::kDiffuse || kind == RaySetKind::kShadow || kind == RaySetKind::kShadowTiled ||
+         kind == RaySetKind::kReintersection;
 }
+
+bool has_exact_count(RaySetKind kind) { return kind != RaySetKind::kShadowTiled; }
 
 std::string to_string(Query query) { return query == Query::kIntersect ? "intersect" : "occluded"; }
 
@@ -123,7 +129,9 @@ RaySetKind parse_rayset_kind(const std::string& name) {
   throw InputError("", fmt::format("unknown ray set '{}' (known: {})", name, fmt::join(rayset_kind_names(), ", ")));
 }
 
-Query query_of(RaySetKind kind) { return kind == RaySetKind::kShadow ? Query::kOccluded : Query::kIntersect; }
+Query query_of(RaySetKind kind) {
+  return kind == RaySetKind::kShadow || kind == RaySetKind::kShadowTiled ? Query::kOccluded : Query::kIntersect;
+}
 
 RayGenerator::RayGenerator(const Scene& scene) : scene_(scene), bounds_(scene.bounds()) {
   if (scene.has_analytic()) {
@@ -187,6 +195,8 @@ std::vector<Ray> RayGenerator::generate(const RaySetSpec& spec, std::vector<std:
   if (sources) sources->assign(spec.count, kNoHit);
   switch (spec.kind) {
     case RaySetKind::kPrimary: return primary(spec, camera);
+    case RaySetKind::kPrimaryTiled: return primary_tiled(spec, camera);
+    case RaySetKind::kShadowTiled: return shadow_tiled(spec, camera, sources);
     case RaySetKind::kDiffuse:
     case RaySetKind::kShadow:
     case RaySetKind::kReintersection: return from_primary_hits(spec, camera, sources);
@@ -198,19 +208,150 @@ std::vector<Ray> RayGenerator::generate(const RaySetSpec& spec, std::vector<std:
   }
 }
 
+namespace {
+
+// The primary grid of N rays: W = ceil(sqrt(N * aspect)) columns and as many
+// rows as N needs; the last row is partly filled.
+struct PixelGrid {
+  std::size_t width = 0, height = 0, count = 0;
+  PixelGrid(std::size_t n, float aspect)
+      : width(static_cast<std::size_t>(std::ceil(std::sqrt(n * static_cast<double>(aspect))))),
+        height(width == 0 ? 0 : (n + width - 1) / width),
+        count(n) {}
+};
+
+// The ray through pixel i (in scanline order) of the grid, jittered by the
+// pixel's own random numbers: the same ray whatever order the pixels come in.
+Ray pixel_ray(const RaySetSpec& spec, const Camera& camera, const PixelGrid& grid, std::size_t i) {
+  Rng rng(spec.seed, stream_of(RaySetKind::kPrimary), i);
+  const double sx = (static_cast<double>(i % grid.width) + rng.next_double()) / grid.width;
+  const double sy = (static_cast<double>(i / grid.width) + rng.next_double()) / grid.height;
+  return camera_ray(camera, sx, sy);
+}
+
+// The grid's scanline pixel indices in tile order: 8x8 tiles in scanline
+// order of tiles; inside a tile the bits of the position k = 0..63 give
+// x = k0 + 2 k1 + 4 k4 and y = k2 + 2 k3 + 4 k5, so 8 consecutive pixels form
+// a 4x2 block, 16 a 4x4 block, 32 an 8x4 half tile and 64 the tile. Pixels
+// outside the grid (partial tiles at the right and bottom, the partial last
+// row) are skipped: every pixel exactly once.
+std::vector<std::size_t> tiled_pixel_order(const PixelGrid& grid) {
+  constexpr std::size_t kTile = 8;
+  std::vector<std::size_t> order;
+  order.reserve(grid.count);
+  for (std::size_t ty = 0; ty < grid.height; ty += kTile)
+    for (std::size_t tx = 0; tx < grid.width; tx += kTile)
+      for (std::size_t k = 0; k < kTile * kTile; ++k) {
+        const std::size_t x = tx + (k & 1) + (k >> 1 & 1) * 2 + (k >> 4 & 1) * 4;
+        const std::size_t y = ty + (k >> 2 & 1) + (k >> 3 & 1) * 2 + (k >> 5 & 1) * 4;
+        if (x < grid.width && y * grid.width + x < grid.count) order.push_back(y * grid.width + x);
+      }
+  return order;
+}
+
+}  // namespace
+
 // A jittered W x H grid in scanline order (coherent, as a renderer issues
 // them): W = ceil(sqrt(N * aspect)), and the last row is partly filled.
 std::vector<Ray> RayGenerator::primary(const RaySetSpec& spec, const Camera& camera) const {
   std::vector<Ray> rays(spec.count);
-  const auto width = static_cast<std::size_t>(std::ceil(std::sqrt(spec.count * static_cast<double>(camera.aspect))));
-  const std::size_t height = width == 0 ? 0 : (spec.count + width - 1) / width;
-  tbb::parallel_for(std::size_t{0}, spec.count, [&](std::size_t i) {
-    Rng rng(spec.seed, stream_of(RaySetKind::kPrimary), i);
-    const double sx = (static_cast<double>(i % width) + rng.next_double()) / width;
-    const double sy = (static_cast<double>(i / width) + rng.next_double()) / height;
-    rays[i] = camera_ray(camera, sx, sy);
-  });
+  const PixelGrid grid(spec.count, camera.aspect);
+  tbb::parallel_for(std::size_t{0}, spec.count, [&](std::size_t i) { rays[i] = pixel_ray(spec, camera, grid, i); });
   return rays;
+}
+
+// primary's rays, bit for bit, in tiled_pixel_order: a permutation of primary.
+std::vector<Ray> RayGenerator::primary_tiled(const RaySetSpec& spec, const Camera& camera) const {
+  const PixelGrid grid(spec.count, camera.aspect);
+  const std::vector<std::size_t> order = tiled_pixel_order(grid);
+  std::vector<Ray> rays(order.size());
+  tbb::parallel_for(std::size_t{0}, order.size(), [&](std::size_t k) { rays[k] = pixel_ray(spec, camera, grid, order[k]); });
+  return rays;
+}
+
+// One shadow ray (as secondary_ray makes them for `shadow`) from each hit of
+// the primary-tiled rays, in their order. Pixels that miss, or whose hit has
+// no usable normal, give no ray: the set holds at most spec.count rays.
+std::vector<Ray> RayGenerator::shadow_tiled(const RaySetSpec& spec, const Camera& camera,
+                                            std::vector<std::int32_t>* sources) const {
+  const Vec3f light = spec.light.value_or(default_light());
+  const std::vector<Ray> pixels = primary_tiled(spec, camera);
+  std::vector<Ray> candidates(pixels.size());
+  std::vector<std::int32_t> candidate_sources(pixels.size(), kNoHit);
+  std::vector<std::uint8_t> made(pixels.size(), 0);
+  tbb::parallel_for(std::size_t{0}, pixels.size(), [&](std::size_t k) {
+    const Hit hit = closest_hit(pixels[k]);
+    if (!hit.hit()) return;
+    Rng unused(spec.seed, stream_of(RaySetKind::kShadowTiled), k);  // shadow rays draw no random numbers
+    if (!secondary_ray(RaySetKind::kShadow, pixels[k], hit, light, unused, k, candidates[k])) return;
+    candidate_sources[k] = hit.prim;
+    made[k] = 1;
+  });
+  std::vector<Ray> out;
+  out.reserve(pixels.size());
+  if (sources) sources->clear();
+  for (std::size_t k = 0; k < pixels.size(); ++k) {
+    if (!made[k]) continue;
+    out.push_back(candidates[k]);
+    if (sources) sources->push_back(candidate_sources[k]);
+  }
+  if (out.empty() && spec.count > 0)
+    throw InputError(scene_.name, fmt::format("the camera sees nothing of the scene (none of {} primary-tiled rays hit); "
+                                              "set a camera for it in the suite manifest", pixels.size()));
+  return out;
+}
+
+bool RayGenerator::secondary_ray(RaySetKind kind, const Ray& primary, const Hit& hit, Vec3f light, Rng& rng,
+                                 std::size_t index, Ray& out) const {
+  Eigen::Vector3d n, p;
+  if (static_cast<std::size_t>(hit.prim) < scene_.triangles.size()) {
+    const Triangle& tri = scene_.triangles[hit.prim];
+    const Eigen::Vector3d v0 = to_eigen(tri.v0), v1 = to_eigen(tri.v1), v2 = to_eigen(tri.v2);
+    n = (v1 - v0).cross(v2 - v0);
+    if (!(n.norm() > 0.0)) return false;  // zero-area triangle: no normal to bounce around
+    n.normalize();
+    // The hit point from barycentrics (more accurate than org + t dir).
+    p = (1.0 - hit.u - hit.v) * v0 + hit.u * v1 + hit.v * v2;
+  } else {
+    // An analytic hit: org + t dir moved onto the surface (t's rounding
+    // would otherwise leave it off by more than the offset below), and
+    // the outward normal there.
+    const Eigen::Vector3d org = to_eigen(primary.org), dir = to_eigen(primary.dir);
+    const SurfacePoint s =
+        nearest_surface_point(scene_.primitives(), static_cast<std::size_t>(hit.prim), org + static_cast<double>(hit.t) * dir, org, dir);
+    p = s.point;
+    n = s.normal;
+  }
+  // Offset off the surface on the side the primary ray came from (the
+  // inside, for a camera inside a sphere or box).
+  if (n.dot(to_eigen(primary.dir)) > 0.0) n = -n;  // face the incoming ray
+  Ray r;
+  r.org = offset_ray_origin(to_vec(p), to_vec(n));
+  // Reintersection (G18): odd rays toward a random point of the bounds,
+  // which may lie behind the surface; even rays like diffuse ones.
+  if (kind == RaySetKind::kReintersection && index % 2 == 1) {
+    const Eigen::Vector3d target = to_eigen(bounds_.lower) + Eigen::Vector3d(rng.next_double(), rng.next_double(),
+                                                                             rng.next_double()).cwiseProduct(to_eigen(bounds_.extent()));
+    const Eigen::Vector3d d = target - to_eigen(r.org);
+    if (!(d.norm() > 0.0)) return false;
+    r.dir = to_vec(d.normalized());
+  } else if (kind != RaySetKind::kShadow) {
+    // Cosine-weighted hemisphere (Malley's method).
+    const double r1 = rng.next_double(), phi = 2.0 * std::numbers::pi * rng.next_double();
+    const double radius = std::sqrt(r1);
+    Eigen::Vector3d b1, b2;
+    basis(n, b1, b2);
+    const Eigen::Vector3d d = (b1 * (radius * std::cos(phi)) + b2 * (radius * std::sin(phi)) + n * std::sqrt(1.0 - r1)).normalized();
+    r.dir = to_vec(d);
+  } else {
+    const Eigen::Vector3d to_light = to_eigen(light) - to_eigen(r.org);
+    const double distance = to_light.norm();
+    if (!(distance > 0.0)) return false;
+    r.dir = to_vec(to_light / distance);
+    r.tfar = static_cast<float>(distance);
+  }
+  out = r;
+  return true;
 }
 
 // One ray per primary hit, primary rays through uniformly random pixels,
@@ -237,54 +378,7 @@ std::vector<Ray> RayGenerator::from_primary_hits(const RaySetSpec& spec, const C
       const Ray primary = camera_ray(camera, rng.next_double(), rng.next_double());
       const Hit hit = closest_hit(primary);
       if (!hit.hit()) return;
-      Eigen::Vector3d n, p;
-      if (static_cast<std::size_t>(hit.prim) < scene_.triangles.size()) {
-        const Triangle& tri = scene_.triangles[hit.prim];
-        const Eigen::Vector3d v0 = to_eigen(tri.v0), v1 = to_eigen(tri.v1), v2 = to_eigen(tri.v2);
-        n = (v1 - v0).cross(v2 - v0);
-        if (!(n.norm() > 0.0)) return;  // zero-area triangle: no normal to bounce around
-        n.normalize();
-        // The hit point from barycentrics (more accurate than org + t dir).
-        p = (1.0 - hit.u - hit.v) * v0 + hit.u * v1 + hit.v * v2;
-      } else {
-        // An analytic hit: org + t dir moved onto the surface (t's rounding
-        // would otherwise leave it off by more than the offset below), and
-        // the outward normal there.
-        const Eigen::Vector3d org = to_eigen(primary.org), dir = to_eigen(primary.dir);
-        const SurfacePoint s =
-            nearest_surface_point(scene_.primitives(), static_cast<std::size_t>(hit.prim), org + static_cast<double>(hit.t) * dir, org, dir);
-        p = s.point;
-        n = s.normal;
-      }
-      // Offset off the surface on the side the primary ray came from (the
-      // inside, for a camera inside a sphere or box).
-      if (n.dot(to_eigen(primary.dir)) > 0.0) n = -n;  // face the incoming ray
-      Ray r;
-      r.org = offset_ray_origin(to_vec(p), to_vec(n));
-      // Reintersection (G18): odd rays toward a random point of the bounds,
-      // which may lie behind the surface; even rays like diffuse ones.
-      if (spec.kind == RaySetKind::kReintersection && (first + j) % 2 == 1) {
-        const Eigen::Vector3d target = to_eigen(bounds_.lower) + Eigen::Vector3d(rng.next_double(), rng.next_double(),
-                                                                                 rng.next_double()).cwiseProduct(to_eigen(bounds_.extent()));
-        const Eigen::Vector3d d = target - to_eigen(r.org);
-        if (!(d.norm() > 0.0)) return;
-        r.dir = to_vec(d.normalized());
-      } else if (spec.kind != RaySetKind::kShadow) {
-        // Cosine-weighted hemisphere (Malley's method).
-        const double r1 = rng.next_double(), phi = 2.0 * std::numbers::pi * rng.next_double();
-        const double radius = std::sqrt(r1);
-        Eigen::Vector3d b1, b2;
-        basis(n, b1, b2);
-        const Eigen::Vector3d d = (b1 * (radius * std::cos(phi)) + b2 * (radius * std::sin(phi)) + n * std::sqrt(1.0 - r1)).normalized();
-        r.dir = to_vec(d);
-      } else {
-        const Eigen::Vector3d to_light = to_eigen(light) - to_eigen(r.org);
-        const double distance = to_light.norm();
-        if (!(distance > 0.0)) return;
-        r.dir = to_vec(to_light / distance);
-        r.tfar = static_cast<float>(distance);
-      }
-      candidates[j] = r;
+      if (!secondary_ray(spec.kind, primary, hit, light, rng, first + j, candidates[j])) return;
       candidate_sources[j] = hit.prim;
       made[j] = 1;
     });

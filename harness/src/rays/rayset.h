@@ -11,6 +11,7 @@
 #include "raybench/bvh/mixed_bvh2.h"
 #include "raybench/math/ray.h"
 #include "raybench/prim/triangle_mt.h"
+#include "scene/random.h"
 #include "scene/scene.h"
 
 namespace raybench {
@@ -20,6 +21,10 @@ enum class RaySetKind {
   kDiffuse,
   kShadow,
   kUniform,
+  // Coherent orders (issue 32): the primary pixels in screen tiles, and
+  // shadow rays from their hits in the same order.
+  kPrimaryTiled,  // primary's jittered pixels, reordered: 8x8 tiles of 4x2 blocks
+  kShadowTiled,   // one shadow ray per hit of primary-tiled, in its order
   // Must-hit ray sets of ../shared/EXTREMES.md, for closed meshes that
   // declare a ball inside them: every ray must hit, a miss is a leak.
   kClosedInsideRandom,  // G01: origins in the ball, uniform directions
@@ -53,6 +58,9 @@ bool is_must_hit(RaySetKind kind);
 // True for rays that start on a surface (diffuse, shadow, reintersection):
 // they have a source primitive, and hitting it again is a self-intersection.
 bool has_sources(RaySetKind kind);
+// False for shadow-tiled: one ray per hit of the N primary-tiled rays, so a
+// set asked for N rays holds at most N. Every other kind has exactly N.
+bool has_exact_count(RaySetKind kind);
 
 // A pinhole camera; y is up unless `up` says otherwise.
 struct Camera {
@@ -107,6 +115,14 @@ class RayGenerator {
 
  private:
   std::vector<Ray> primary(const RaySetSpec& spec, const Camera& camera) const;
+  std::vector<Ray> primary_tiled(const RaySetSpec& spec, const Camera& camera) const;
+  std::vector<Ray> shadow_tiled(const RaySetSpec& spec, const Camera& camera, std::vector<std::int32_t>* sources) const;
+  // The secondary ray of `kind` (diffuse, shadow, reintersection) leaving
+  // `hit` of `primary`; `index` is the candidate's number (reintersection
+  // alternates on it) and `rng` draws the bounce. False when the hit has no
+  // usable normal or the direction is undefined: no ray.
+  bool secondary_ray(RaySetKind kind, const Ray& primary, const Hit& hit, Vec3f light, Rng& rng, std::size_t index,
+                     Ray& out) const;
   std::vector<Ray> from_primary_hits(const RaySetSpec& spec, const Camera& camera, std::vector<std::int32_t>* sources) const;
   std::vector<Ray> uniform(const RaySetSpec& spec) const;
   std::vector<Ray> must_hit(const RaySetSpec& spec) const;

@@ -75,7 +75,8 @@ std::vector<Ray> obtain_rays(const RayGenerator& generator, const Scene& scene, 
   if (!sources && std::filesystem::exists(path, ec)) {
     try {
       std::vector<Ray> rays = read_ray_file(path);
-      if (rays.size() == spec.count) {
+      // shadow-tiled holds one ray per hit, at most the count asked for.
+      if (has_exact_count(spec.kind) ? rays.size() == spec.count : rays.size() <= spec.count) {
         progress(fmt::format("  {} rays: reusing {}", to_string(spec.kind), path));
         return rays;
       }
