@@ -204,6 +204,50 @@ class SuiteRun(CliTest):
         # Embree's default mode is not watertight (EXTREMES.md: ~22 % of vertex-aimed rays miss).
         self.assertGreater(int(rows[("vertex-aimed", "embree")]["leaks"]), 100)
 
+    def test_tiled_ray_sets_are_stored_and_reused_and_shadow_tiled_holds_one_ray_per_hit(self):
+        out, rays_dir = self.path("tiled.csv"), self.path("rays")
+        args = ["run", "--scene", SCENE, "--rayset", "primary-tiled,shadow-tiled", "--rays", "3000", "--reps", "1",
+                "--build-reps", "1", "--min-time", "0.01", "--backend", "embree,bvh8", "--out", out,
+                "--rays-dir", rays_dir]
+        result = run(*args)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        rows = {(r["rayset"], r["backend"]): r for r in read_csv(out)[1]}
+        self.assertEqual(len(rows), 4)
+        for backend in ("embree", "bvh8"):
+            tiled, shadow = rows[("primary-tiled", backend)], rows[("shadow-tiled", backend)]
+            self.assertEqual((tiled["rays"], tiled["query"]), ("3000", "intersect"))
+            # One shadow ray per pixel that hits: the camera sees the sky too.
+            self.assertEqual(shadow["query"], "occluded")
+            self.assertLess(int(shadow["rays"]), 3000)
+            self.assertAlmostEqual(int(shadow["rays"]) / 3000, float(tiled["hit_rate"]), delta=0.01)
+            for row in (tiled, shadow):
+                self.assertGreaterEqual(float(row["agree_hit"]), 0.9999, row)
+        stored = sorted(os.listdir(rays_dir))
+        self.assertEqual(len(stored), 2)
+        self.assertTrue(any(".shadow-tiled.n3000." in name for name in stored), stored)
+        # A second run reuses both stored sets, the shorter shadow-tiled one included.
+        again = run(*args)
+        self.assertEqual(again.returncode, 0, again.stderr)
+        self.assertIn("primary-tiled rays: reusing", again.stderr)
+        self.assertIn("shadow-tiled rays: reusing", again.stderr)
+        self.assertEqual(sorted(os.listdir(rays_dir)), stored)
+
+    def test_the_coherent_suite_is_the_default_suites_scenes_with_the_tiled_ray_sets(self):
+        meshes = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "meshes")
+        with open(os.path.join(meshes, "default.toml"), "rb") as f:
+            default = tomllib.load(f)
+        with open(os.path.join(meshes, "coherent.toml"), "rb") as f:
+            coherent = tomllib.load(f)
+        self.assertEqual(coherent["defaults"]["raysets"],
+                         ["primary", "primary-tiled", "shadow", "shadow-tiled", "diffuse", "uniform"])
+        # Every default scene but the must-hit sphere, with the same path, camera, light and
+        # optional flag; the analytic terrain without its tessellation study.
+        expected = [{k: v for k, v in scene.items() if k != "tessellate"}
+                    for scene in default["scene"] if scene["name"] != "sphere"]
+        self.assertEqual(coherent["scene"], expected)
+        result = run("run", "--suite", os.path.join(meshes, "coherent.toml"), "--list")
+        self.assertEqual(result.returncode, 0, result.stderr)
+
     def test_accuracy_judges_every_ray_and_writes_its_own_csv(self):
         out, accuracy = self.path("run.csv"), self.path("acc", "accuracy.csv")
         result = run("run", "--scene", "proc:tiny_triangles", "--rayset", "tiny-triangles,invalid-rays", "--rays", "3000",
