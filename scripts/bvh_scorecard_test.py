@@ -289,6 +289,26 @@ def issue33_run():
     return rows
 
 
+def coherent_run():
+    """Scenes a and b as meshes/coherent.toml runs them, one thread: Embree's best coherent mode is
+    packet8 at 14 (its incoherent stream, 30, is no coherent mode); bvh8:packet 21 on the tiled rows
+    but 17 on b shadow-tiled, and 0.91 x bvh8 on b uniform."""
+    rows = []
+    for scene in ("a", "b"):
+        for kind in ("primary-tiled", "shadow-tiled", "diffuse", "uniform"):
+            tiled = kind.endswith("-tiled")
+            packet = 17.0 if (scene, kind) == ("b", "shadow-tiled") else 21.0 if tiled else \
+                10.0 if (scene, kind) == ("b", "uniform") else 10.8
+            rows += [spread(row(scene, kind, "embree", 10.0), 9.9, 10.1),
+                     row(scene, kind, "embree:packet4", 12.0),
+                     spread(row(scene, kind, "embree:packet8", 14.0), 13.9, 14.1),
+                     row(scene, kind, "embree:stream", 13.0),
+                     row(scene, kind, "embree:stream:incoherent", 30.0),
+                     spread(row(scene, kind, "bvh8", 11.0), 10.9, 11.1),
+                     spread(row(scene, kind, "bvh8:packet", packet), packet - 1.0, packet + 1.0)]
+    return rows
+
+
 class MachineScorecard(unittest.TestCase):
     def test_a_machine_class_is_the_cpus_vendor_family_and_model(self):
         from machine_scorecard import machine_class
@@ -336,6 +356,54 @@ class MachineScorecard(unittest.TestCase):
         # A run without Embree provenance predates issue 33's Embree wrapper fix: its ratios overstate ours.
         self.assertIn("This run predates issue 33's Embree wrapper fix and memory policy (its metadata records no Embree "
                       "provenance): Embree was traced through a slower loop, so its ratios overstate ours.", out)
+
+    def test_the_coherent_section_holds_our_best_packet_mode_to_embrees_best_coherent_mode(self):
+        with tempfile.TemporaryDirectory() as d:
+            result = scorecard_cli(write_run(d, "run", coherent_run(), INTEL), "--no-plot")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        out = result.stdout
+        self.assertIn("## Coherent rays (issue 32)", out)
+        # 21 / 14 (embree:packet8, not the incoherent stream's 30) and 21 / 10.
+        self.assertIn("| a | primary-tiled | bvh8:packet | embree:packet8 | 1.50 (1.42–1.58) | 2.10 (1.98–2.22) |", out)
+        self.assertIn("| b | shadow-tiled | bvh8:packet | embree:packet8 | 1.21 (1.13–1.29) | 1.70 (1.58–1.82) |", out)
+        self.assertIn("### Issue 32's targets: 0 of 3 met", out)
+        # b shadow-tiled reaches 18 / 13.9 = 1.29 at best: beyond noise.
+        self.assertIn("| our best coherent ≥ 1.30 × Embree's best coherent mode, every row (primary-tiled, shadow-tiled) "
+                      "| min 1.21 (b shadow-tiled); 1 of 4 rows below 1.30 | **missed** |", out)
+        self.assertIn("b shadow-tiled 1.21 (1.13–1.29), beyond noise", out)
+        # (2.1^3 x 1.7)^(1/4) = 1.99.
+        self.assertIn("| our best coherent ≥ 2.0 × `embree` (rtcIntersect1), geometric mean over primary-tiled, "
+                      "shadow-tiled | 1.99 over 4 rows | **missed** |", out)
+        # On incoherent rays: 10.8 / 11 = 0.98, but b uniform 10 / 11 = 0.91, reaching 11 / 10.9 = 1.01: within noise.
+        self.assertIn("| a | diffuse | bvh8:packet / bvh8 | 0.98 (0.88–1.08) |", out)
+        self.assertIn("| every packet backend of ours ≥ 0.95 × itself without `packet`, every row (diffuse, uniform) "
+                      "| min 0.91 (b uniform); 1 of 4 rows below 0.95 | **missed** |", out)
+        self.assertIn("b uniform 0.91 (0.81–1.01), within noise", out)
+
+    def test_the_coherent_targets_are_met_and_not_measurable_as_the_run_says(self):
+        rows = [r for r in coherent_run() if not (r["scene"] == "b" and r["backend"] == "bvh8:packet")]
+        with tempfile.TemporaryDirectory() as d:
+            out = scorecard_cli(write_run(d, "run", rows, INTEL), "--no-plot").stdout
+        self.assertIn("| our best coherent ≥ 1.30 × Embree's best coherent mode, every row (primary-tiled, shadow-tiled) "
+                      "| min 1.50 (a primary-tiled) | **met** |", out)
+        self.assertIn("| 2.10 over 2 rows | **met** |", out)
+        self.assertIn("### Issue 32's targets: 3 of 3 met", out)
+        # Without Embree's coherent modes the first target cannot be measured; without the tiled rows
+        # the second neither; a run without any packet backend of ours has no coherent section at all.
+        no_embree_modes = [r for r in rows if not r["backend"].startswith("embree:")]
+        with tempfile.TemporaryDirectory() as d:
+            out = scorecard_cli(write_run(d, "run", no_embree_modes, INTEL), "--no-plot").stdout
+        self.assertIn("| no rows: no Embree packet or stream mode beside a packet backend of ours | **not measurable** |", out)
+        untiled = [r for r in rows if not r["rayset"].endswith("-tiled")]
+        with tempfile.TemporaryDirectory() as d:
+            out = scorecard_cli(write_run(d, "run", untiled, INTEL), "--no-plot").stdout
+        self.assertIn("| our best coherent ≥ 2.0 × `embree` (rtcIntersect1), geometric mean over primary-tiled, "
+                      "shadow-tiled | no rows | **not measurable** |", out)
+        single = [r for r in rows if "packet" not in r["backend"]]
+        with tempfile.TemporaryDirectory() as d:
+            out = scorecard_cli(write_run(d, "run", single, INTEL), "--no-plot").stdout
+        self.assertIn("## Issue 33's targets", out)
+        self.assertNotIn("Coherent rays", out)
 
     def test_a_target_whose_rows_the_run_lacks_is_not_measurable_never_met(self):
         rows = [r for r in issue33_run() if r["rayset"] != "uniform" and r["threads"] == 1]

@@ -19,6 +19,14 @@ A target whose rows the run lacks (a ray kind, the two-thread rows, a watertight
 "not measurable", never met. A missed per-row target names its rows, each within the noise of
 the repetitions (its range reaches the target) or beyond it.
 
+Issue 32's coherent section, when the run has tiled rows (meshes/coherent.toml), one thread:
+- on primary-tiled and shadow-tiled, our best coherent mode (a backend of ours whose name has a
+  `packet` option) >= 1.30 x Embree's best coherent mode (the fastest of its `packet4/8/16` and
+  `stream` modes, never `stream:incoherent`) on every row, and >= 2.0 x `embree` (rtcIntersect1)
+  as a geometric mean over those rows;
+- on diffuse and uniform rays every packet backend of ours >= 0.95 x the same backend without
+  `packet` (it falls back to single rays, so a user can leave it on).
+
 Each scorecard ends with a machine-readable summary (an HTML comment) that write_index reads back
 to make results/scorecards/README.md: one line per machine class.
 """
@@ -32,6 +40,9 @@ from report import InputError, geometric_mean, read_meta
 
 RAY_KINDS = ("primary", "diffuse", "shadow", "uniform")
 TRACED_KINDS = ("primary", "diffuse", "shadow")  # the kinds of the our-best targets
+TILED_KINDS = ("primary-tiled", "shadow-tiled")  # issue 32's coherent targets
+INCOHERENT_KINDS = ("diffuse", "uniform")  # where a packet backend must cost nothing
+EMBREE_COHERENT_MODES = ("packet4", "packet8", "packet16", "stream")
 SUMMARY_MARK = "<!-- machine-scorecard-summary "
 
 
@@ -226,6 +237,115 @@ def targets(lines, rows):
     return out
 
 
+def is_our_coherent(backend):
+    """A backend of ours in a packet mode: `bvh8:packet`, `bvh8:packet:watertight`."""
+    return is_ours(backend) and "packet" in backend.split(":")[1:]
+
+
+def is_embree_coherent(backend):
+    """An Embree packet or coherent stream mode: `embree:packet8`, `embree:high:stream`; not
+    `embree:stream:incoherent`, which is the incoherent stream."""
+    parts = backend.split(":")
+    return (parts[0] == "embree" and any(m in parts[1:] for m in EMBREE_COHERENT_MODES)
+            and "incoherent" not in parts)
+
+
+def single_ray_twin(backend):
+    """`bvh8:packet` -> `bvh8`: the same backend without its packet option."""
+    return ":".join(p for p in backend.split(":") if p != "packet")
+
+
+def coherent_rows_of(rows, threads=1):
+    """Per (scene, ray kind) at `threads`, in the run's order: issue 32's ratios. Tiled kinds: our best
+    coherent mode against Embree's best coherent mode (`coh_coh`) and against `embree` (`coh_embree`);
+    incoherent kinds: the packet backend of ours that loses most against its single-ray twin
+    (`packet_single`)."""
+    by = {}
+    for r in rows:
+        if r["threads"] == threads and r["rayset"] in TILED_KINDS + INCOHERENT_KINDS and r["mrays_s"]:
+            by.setdefault((r["scene"], r["rayset"]), {})[r["backend"]] = r
+    lines = []
+    for (scene, kind), backends in by.items():
+        ours = [b for b in backends if is_our_coherent(b)]
+        if not ours:
+            continue
+        line = {"scene": scene, "rayset": kind}
+        if kind in TILED_KINDS:
+            best_name, best = fastest(backends, ours)
+            embree_name, embree_best = fastest(backends, [b for b in backends if is_embree_coherent(b)])
+            line.update(best=best_name, best_embree=embree_name)
+            line["coh_coh"], line["coh_coh_range"] = ratio(best, embree_best)
+            line["coh_embree"], line["coh_embree_range"] = ratio(best, backends.get("embree"))
+        else:
+            pairs = [(b, ratio(backends[b], backends.get(single_ray_twin(b)))) for b in ours]
+            pairs = [(b, r) for b, r in pairs if r[0] is not None]
+            if not pairs:
+                continue
+            name, (value, span) = min(pairs, key=lambda p: p[1][0])
+            line.update(best=name, single=single_ray_twin(name), packet_single=value, packet_single_range=span)
+        lines.append(line)
+    return lines
+
+
+def coherent_targets(lines):
+    """Issue 32's targets evaluated on the coherent lines: a list of {text, status, measured, misses}."""
+    tiled = [x for x in lines if x["rayset"] in TILED_KINDS]
+    out = [per_row_target("our best coherent ≥ 1.30 × Embree's best coherent mode, every row (primary-tiled, "
+                          "shadow-tiled)", tiled, "coh_coh", 1.30, TILED_KINDS,
+                          "no Embree packet or stream mode beside a packet backend of ours")]
+    values = [x["coh_embree"] for x in tiled if x["coh_embree"] is not None]
+    missing = [k for k in TILED_KINDS if not any(x["rayset"] == k and x["coh_embree"] is not None for x in tiled)]
+    mean = geometric_mean(values)
+    geo = {"text": "our best coherent ≥ 2.0 × `embree` (rtcIntersect1), geometric mean over primary-tiled, "
+                   "shadow-tiled", "misses": []}
+    if mean is None or missing:
+        geo.update(status="not measurable", measured="no rows" if mean is None else
+                   f"{mean:.2f}; the run has no {', '.join(missing)} rows")
+    else:
+        geo.update(status="met" if mean >= 2.0 else "missed", measured=f"{mean:.2f} over {len(values)} rows")
+    out.append(geo)
+    out.append(per_row_target("every packet backend of ours ≥ 0.95 × itself without `packet`, every row (diffuse, "
+                              "uniform)", [x for x in lines if x["rayset"] in INCOHERENT_KINDS], "packet_single", 0.95,
+                              INCOHERENT_KINDS, "no packet backend of ours beside its single-ray twin"))
+    return out
+
+
+def render_coherent(rows):
+    """Issue 32's section: the coherent rows, the incoherent ones and the targets; [] for a run
+    without a packet backend of ours on the tiled or incoherent rays."""
+    lines = coherent_rows_of(rows)
+    if not lines:
+        return []
+    evaluated = coherent_targets(lines)
+    met = sum(t["status"] == "met" for t in evaluated)
+    out = ["", "## Coherent rays (issue 32)", "",
+           "Rays in screen tiles (docs/raysets.md#coherent-orders), one thread. Our best coherent mode is the fastest "
+           "backend of ours with a `packet` option; Embree's the fastest of `embree:packet4/8/16` and `embree:stream`.",
+           "", "| scene | ray kind | our best coherent | Embree's best coherent | ours / Embree's best coherent "
+           "| ours / `embree` |", "|---|---|---|---|---:|---:|"]
+    for x in lines:
+        if x["rayset"] in TILED_KINDS:
+            out.append(f"| {x['scene']} | {x['rayset']} | {x['best']} | {x['best_embree'] or '-'} | "
+                       f"{fmt_ratio(x['coh_coh'], x['coh_coh_range'])} | "
+                       f"{fmt_ratio(x['coh_embree'], x['coh_embree_range'])} |")
+    incoherent = [x for x in lines if x["rayset"] in INCOHERENT_KINDS]
+    if incoherent:
+        out += ["", "On incoherent rays a packet backend falls back to single rays: its rate against the same "
+                "backend without `packet` (the packet backend that loses most, per row).", "",
+                "| scene | ray kind | packet backend | / single-ray |", "|---|---|---|---:|"]
+        for x in incoherent:
+            out.append(f"| {x['scene']} | {x['rayset']} | {x['best']} / {x['single']} | "
+                       f"{fmt_ratio(x['packet_single'], x['packet_single_range'])} |")
+    out += ["", f"### Issue 32's targets: {met} of {len(evaluated)} met", "", "| target | measured | |",
+            "|---|---|---|"]
+    out += [f"| {t['text']} | {t['measured']} | **{t['status']}** |" for t in evaluated]
+    missed = [t for t in evaluated if t["misses"]]
+    if missed:
+        out += ["", "Rows below their target:"]
+        out += [f"- {t['text']}: " + "; ".join(t["misses"]) + "." for t in missed]
+    return out
+
+
 def summary(meta, lines, evaluated, source):
     """The facts of the index line of this scorecard."""
     traced = [x["best_best"] for x in lines if x["rayset"] in TRACED_KINDS and x["best_best"] is not None]
@@ -312,6 +432,7 @@ def render(rows, meta, source, plot=None):
             out.append(f"- {t['text']}: " + "; ".join(t["misses"]) + ".")
     if plot:
         out += ["", f"![bvh8 against embree and our best against Embree's best, per scene and ray kind]({plot})"]
+    out += render_coherent(rows)
     return out, summary(meta, lines, evaluated, source)
 
 
