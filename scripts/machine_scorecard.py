@@ -238,8 +238,8 @@ def targets(lines, rows):
 
 
 def is_our_coherent(backend):
-    """A backend of ours in a packet mode: `bvh8:packet`, `bvh8:packet:watertight`."""
-    return is_ours(backend) and "packet" in backend.split(":")[1:]
+    """A backend of ours in a packet mode: `bvh8:packet`, `bvh8:packet16`, `bvh8:packet:watertight`."""
+    return is_ours(backend) and any(p.startswith("packet") for p in backend.split(":")[1:])
 
 
 def is_embree_coherent(backend):
@@ -252,7 +252,7 @@ def is_embree_coherent(backend):
 
 def single_ray_twin(backend):
     """`bvh8:packet` -> `bvh8`: the same backend without its packet option."""
-    return ":".join(p for p in backend.split(":") if p != "packet")
+    return ":".join(p for p in backend.split(":") if not p.startswith("packet"))
 
 
 def coherent_rows_of(rows, threads=1):
