@@ -1,5 +1,11 @@
-// The only file that includes Embree. Embree 3 (Debian libembree-dev),
-// single-ray API: rtcIntersect1 for closest hit, rtcOccluded1 for any hit.
+// The only file that includes Embree. Embree 3 (Debian libembree-dev):
+// rtcIntersect1 for closest hit, rtcOccluded1 for any hit; with a ray mode
+// (embree_options.h, issue 32) the packet calls rtcIntersect4/8/16 over
+// consecutive rays of a chunk, or rtcIntersect1M over the chunk as a stream.
+// A packet lane Embree must not trace (a tail lane, a screened ray with an
+// empty interval) gets valid = 0 and also holds an empty interval, because
+// an emulated width ignores the mask (rtcore.cpp hands it to the stream
+// filter, which skips rays with tnear > tfar).
 //
 // Every primitive type of a scene (raybench/prim/primitives.h) is modelled
 // natively, one Embree geometry per type, attached only when the scene has
@@ -33,6 +39,7 @@
 #include <iterator>
 #include <memory>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -52,6 +59,7 @@
 #include "raybench/prim/analytic_hit.h"
 #include "raybench/prim/obb_eigen.h"
 #include "raybench/prim/primitives.h"
+#include "rays/screening.h"
 
 namespace raybench {
 namespace {
@@ -320,6 +328,70 @@ inline void load(RTCRay& out, const Ray& in) {
   out.tfar = in.tfar;
 }
 
+// Embree's packet types and calls of one width.
+template <int K>
+struct Packet;
+
+template <>
+struct Packet<4> {
+  using RayHitK = RTCRayHit4;
+  using RayK = RTCRay4;
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHitK* r) { rtcIntersect4(valid, s, c, r); }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, RayK* r) { rtcOccluded4(valid, s, c, r); }
+};
+
+template <>
+struct Packet<8> {
+  using RayHitK = RTCRayHit8;
+  using RayK = RTCRay8;
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHitK* r) { rtcIntersect8(valid, s, c, r); }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, RayK* r) { rtcOccluded8(valid, s, c, r); }
+};
+
+template <>
+struct Packet<16> {
+  using RayHitK = RTCRayHit16;
+  using RayK = RTCRay16;
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHitK* r) {
+    rtcIntersect16(valid, s, c, r);
+  }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, RayK* r) { rtcOccluded16(valid, s, c, r); }
+};
+
+// The fields of a packet Embree never writes, for every lane: every mask
+// bit, id, flags, time 0; and kEmptyRay in every lane until load_packet
+// writes it.
+template <int K, typename RayK>
+void init_packet(RayK& packet) {
+  for (int i = 0; i < K; ++i) {
+    packet.org_x[i] = kEmptyRay.org.x, packet.org_y[i] = kEmptyRay.org.y, packet.org_z[i] = kEmptyRay.org.z;
+    packet.dir_x[i] = kEmptyRay.dir.x, packet.dir_y[i] = kEmptyRay.dir.y, packet.dir_z[i] = kEmptyRay.dir.z;
+    packet.tnear[i] = kEmptyRay.tnear, packet.tfar[i] = kEmptyRay.tfar;
+    packet.time[i] = 0.0f;
+    packet.mask[i] = 0xffffffffu;
+    packet.id[i] = 0;
+    packet.flags[i] = 0;
+  }
+}
+
+// `rays` (at most K, screened) into the packet's lanes and the valid mask:
+// -1 where the interval is not empty (tnear <= tfar, what rtcIntersect1M
+// traces too), else 0; lanes past the rays get kEmptyRay and 0.
+template <int K, typename RayK>
+inline void load_packet(RayK& packet, int* valid, std::span<const Ray> rays) {
+  for (std::size_t i = 0; i < static_cast<std::size_t>(K); ++i) {
+    const Ray& r = i < rays.size() ? rays[i] : kEmptyRay;
+    packet.org_x[i] = r.org.x, packet.org_y[i] = r.org.y, packet.org_z[i] = r.org.z;
+    packet.dir_x[i] = r.dir.x, packet.dir_y[i] = r.dir.y, packet.dir_z[i] = r.dir.z;
+    packet.tnear[i] = r.tnear, packet.tfar[i] = r.tfar;
+    valid[i] = r.tnear <= r.tfar ? -1 : 0;
+  }
+}
+
+// Rays per rtcIntersect1M call: a whole chunk of the trace executor (1024)
+// in one stream; a larger span, as a test may pass, in pieces of this size.
+constexpr std::size_t kStreamPiece = 4096;
+
 class EmbreeBackend final : public Backend {
  public:
   EmbreeBackend(std::string name, EmbreeOptions options, const BackendConfig& config)
@@ -338,6 +410,16 @@ class EmbreeBackend final : public Backend {
     if (!device_)
       throw InputError("", embree_device_error(name_, options_, device_config_,
                                                rtcGetDeviceError(nullptr) == RTC_ERROR_UNSUPPORTED_CPU));
+    native_.packet4 = rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED) != 0;
+    native_.packet8 = rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0;
+    native_.packet16 = rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0;
+    native_.stream = rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_RAY_STREAM_SUPPORTED) != 0;
+    if (options_.ray_mode == EmbreeRayMode::kStream && !native_.stream) {
+      rtcReleaseDevice(device_);
+      throw InputError("", fmt::format("backend '{}': this Embree has no ray streams (built without ray packets: "
+                                       "RTC_DEVICE_PROPERTY_RAY_STREAM_SUPPORTED is 0)",
+                                       name_));
+    }
     rtcSetDeviceErrorFunction(
         device_, [](void* self, RTCError, const char* message) { static_cast<EmbreeBackend*>(self)->last_error_ = message; },
         this);
@@ -364,7 +446,9 @@ class EmbreeBackend final : public Backend {
     if (!selection_) selection_ = probe_selection(device_config_, options_);
     const EmbreeLibrary& library = embree_library();
     auto p = embree_provenance(*selection_, device_config_, huge_pages_, library.description, library.assertions);
-    p.emplace_back("summary", embree_summary(*selection_, huge_pages_));
+    p.emplace_back("ray_mode", embree_ray_mode(options_, native_));
+    const std::string mode = embree_ray_mode_summary(options_, native_);
+    p.emplace_back("summary", embree_summary(*selection_, huge_pages_) + (mode.empty() ? "" : ", " + mode));
     return p;
   }
 
@@ -405,8 +489,8 @@ class EmbreeBackend final : public Backend {
   // A triangle-only scene takes the loop without the id mapping, so that its
   // per-ray work is what it was before analytic primitives existed.
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
-    if (analytic_) intersect_rays<true>(rays, hits);
-    else intersect_rays<false>(rays, hits);
+    if (analytic_) intersect_in_mode<true>(rays, hits);
+    else intersect_in_mode<false>(rays, hits);
   }
 
   // Rays are screened (backend.h): finite, tnear >= 0, tfar not NaN, the
@@ -415,6 +499,13 @@ class EmbreeBackend final : public Backend {
   // FLT_LARGE, |tnear|, |tfar| <= inf, tnear >= 0) and finds nothing in an
   // empty interval, leaving tfar as it came.
   void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override {
+    switch (options_.ray_mode) {
+      case EmbreeRayMode::kPacket4: return occluded_packets<4>(rays, occluded);
+      case EmbreeRayMode::kPacket8: return occluded_packets<8>(rays, occluded);
+      case EmbreeRayMode::kPacket16: return occluded_packets<16>(rays, occluded);
+      case EmbreeRayMode::kStream: return occluded_stream(rays, occluded);
+      case EmbreeRayMode::kSingle: break;
+    }
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRay ray = batch_ray();
@@ -428,6 +519,114 @@ class EmbreeBackend final : public Backend {
   }
 
  private:
+  template <bool Analytic>
+  void intersect_in_mode(std::span<const Ray> rays, std::span<Hit> hits) const {
+    switch (options_.ray_mode) {
+      case EmbreeRayMode::kPacket4: return intersect_packets<4, Analytic>(rays, hits);
+      case EmbreeRayMode::kPacket8: return intersect_packets<8, Analytic>(rays, hits);
+      case EmbreeRayMode::kPacket16: return intersect_packets<16, Analytic>(rays, hits);
+      case EmbreeRayMode::kStream: return intersect_stream<Analytic>(rays, hits);
+      case EmbreeRayMode::kSingle: return intersect_rays<Analytic>(rays, hits);
+    }
+  }
+
+  // The context of packets and streams: coherent unless `incoherent`.
+  RTCIntersectContext coherence_context() const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = options_.incoherent ? RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT : RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    return context;
+  }
+
+  // An answer of Embree's into ours, as intersect_rays writes it.
+  template <bool Analytic>
+  Hit hit_of(unsigned geom_id, unsigned prim_id, float t, float u, float v) const {
+    if (geom_id == RTC_INVALID_GEOMETRY_ID) return Hit{};
+    if constexpr (Analytic) {
+      const bool triangle = geom_id == kTriangleGeometry;
+      return {t, static_cast<std::int32_t>(first_id_[geom_id] + prim_id), triangle ? u : 0.0f, triangle ? v : 0.0f};
+    } else {
+      return {t, static_cast<std::int32_t>(prim_id), u, v};
+    }
+  }
+
+  template <int K, bool Analytic>
+  void intersect_packets(std::span<const Ray> rays, std::span<Hit> hits) const {
+    RTCIntersectContext context = coherence_context();
+    typename Packet<K>::RayHitK packet;  // aligned by its type (RTC_ALIGN)
+    alignas(4 * K) int valid[K];
+    init_packet<K>(packet.ray);
+    for (int i = 0; i < K; ++i) packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;  // as intersect_rays
+    for (std::size_t first = 0; first < rays.size(); first += K) {
+      const std::size_t lanes = std::min<std::size_t>(K, rays.size() - first);
+      load_packet<K>(packet.ray, valid, rays.subspan(first, lanes));
+      for (int i = 0; i < K; ++i) packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      Packet<K>::intersect(valid, scene_, &context, &packet);
+      for (std::size_t i = 0; i < lanes; ++i)
+        hits[first + i] = hit_of<Analytic>(packet.hit.geomID[i], packet.hit.primID[i], packet.ray.tfar[i],
+                                           packet.hit.u[i], packet.hit.v[i]);
+    }
+  }
+
+  template <int K>
+  void occluded_packets(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const {
+    RTCIntersectContext context = coherence_context();
+    typename Packet<K>::RayK packet;
+    alignas(4 * K) int valid[K];
+    init_packet<K>(packet);
+    for (std::size_t first = 0; first < rays.size(); first += K) {
+      const std::size_t lanes = std::min<std::size_t>(K, rays.size() - first);
+      load_packet<K>(packet, valid, rays.subspan(first, lanes));
+      Packet<K>::occluded(valid, scene_, &context, &packet);
+      // As occluded(): "occluded" lowers tfar to -inf; a lane Embree did not trace keeps its tfar.
+      for (std::size_t i = 0; i < lanes; ++i) occluded[first + i] = packet.tfar[i] < rays[first + i].tfar;
+    }
+  }
+
+  // The stream's structures, one buffer per thread, grown (rarely: to the
+  // chunk size) outside the per-ray work; the fields Embree never writes
+  // (batch_ray's, instID) are set when an element is made.
+  template <typename T>
+  static std::vector<T>& stream_buffer(std::size_t n, const T& fresh) {
+    thread_local std::vector<T> buffer;
+    if (buffer.size() < n) buffer.resize(n, fresh);
+    return buffer;
+  }
+
+  // rtcIntersect1M traces a ray with tnear > tfar as rtcIntersect1 does (a
+  // screened ray: finite, found nothing), so the stream gets every ray as is.
+  template <bool Analytic>
+  void intersect_stream(std::span<const Ray> rays, std::span<Hit> hits) const {
+    RTCIntersectContext context = coherence_context();
+    RTCRayHit fresh;
+    fresh.ray = batch_ray();
+    fresh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    for (std::size_t first = 0; first < rays.size(); first += kStreamPiece) {
+      const std::size_t n = std::min(kStreamPiece, rays.size() - first);
+      std::vector<RTCRayHit>& stream = stream_buffer(n, fresh);
+      for (std::size_t i = 0; i < n; ++i) {
+        load(stream[i].ray, rays[first + i]);
+        stream[i].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      }
+      rtcIntersect1M(scene_, &context, stream.data(), static_cast<unsigned>(n), sizeof(RTCRayHit));
+      for (std::size_t i = 0; i < n; ++i) {
+        const RTCRayHit& rh = stream[i];
+        hits[first + i] = hit_of<Analytic>(rh.hit.geomID, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v);
+      }
+    }
+  }
+
+  void occluded_stream(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const {
+    RTCIntersectContext context = coherence_context();
+    for (std::size_t first = 0; first < rays.size(); first += kStreamPiece) {
+      const std::size_t n = std::min(kStreamPiece, rays.size() - first);
+      std::vector<RTCRay>& stream = stream_buffer(n, batch_ray());
+      for (std::size_t i = 0; i < n; ++i) load(stream[i], rays[first + i]);
+      rtcOccluded1M(scene_, &context, stream.data(), static_cast<unsigned>(n), sizeof(RTCRay));
+      for (std::size_t i = 0; i < n; ++i) occluded[first + i] = stream[i].tfar < rays[first + i].tfar;
+    }
+  }
+
   template <bool Analytic>
   void intersect_rays(std::span<const Ray> rays, std::span<Hit> hits) const {
     RTCIntersectContext context;
@@ -508,6 +707,7 @@ class EmbreeBackend final : public Backend {
   EmbreeOptions options_;
   std::string device_config_;  // embree_device_config
   bool huge_pages_;            // the memory policy it was given (its option, else the run's)
+  EmbreeNativeRays native_;    // what the device runs natively (rtcGetDeviceProperty)
   mutable std::optional<EmbreeSelection> selection_;  // the probe's, once provenance() asks
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
@@ -536,6 +736,14 @@ std::vector<BackendInfo> embree_backend_names() {
                              "instead of a BVH8 (simd256 is the default; simd512 builds as simd256 in Embree 3.13)"},
           {"embree:hugepages", "Embree with its structures in huge pages whatever the run's memory policy"},
           {"embree:no_hugepages", "Embree with its structures in ordinary pages whatever the run's memory policy"},
+          {"embree:packet4", "Embree's 4-ray packets: rtcIntersect4/rtcOccluded4 over consecutive rays, coherent flag "
+                             "(combines: embree:packet4:incoherent)"},
+          {"embree:packet8", "Embree's 8-ray packets: rtcIntersect8/rtcOccluded8 over consecutive rays, coherent flag"},
+          {"embree:packet16", "Embree's 16-ray packets: rtcIntersect16/rtcOccluded16 over consecutive rays, coherent "
+                              "flag (emulated by Embree where the device has no 16-wide packets)"},
+          {"embree:stream", "Embree's ray stream: rtcIntersect1M/rtcOccluded1M over each chunk of 1024 rays with "
+                            "RTC_INTERSECT_CONTEXT_FLAG_COHERENT"},
+          {"embree:stream:incoherent", "Embree's ray stream with RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT"},
           {"embree:ISA", "Embree forced to one ISA: embree:sse2, embree:sse4.2, embree:avx, embree:avx2, "
                          "embree:avx512 (an ISA this CPU lacks is an error)", "fast", false, true}};
 }

@@ -10,6 +10,10 @@
 // builds a BVH4 instead of a BVH8), medium build quality, RTC_SCENE_FLAG_NONE,
 // a static scene, and Embree's own choice of ISA (the best the CPU has).
 // docs/backends.md, "Embree's configuration", cites the passages.
+// The ray mode (issue 32) is how the rays of a chunk reach Embree: one at a
+// time (rtcIntersect1, the default), in packets of 4, 8 or 16 consecutive rays
+// (rtcIntersect4/8/16), or as one stream (rtcIntersect1M); packets and streams
+// carry RTC_INTERSECT_CONTEXT_FLAG_COHERENT unless `incoherent` is given.
 #pragma once
 
 #include <optional>
@@ -19,6 +23,9 @@
 namespace raybench {
 
 enum class EmbreeQuality { kLow, kMedium, kHigh };
+
+// How a chunk's rays reach Embree: `embree`, `embree:packet4|8|16`, `embree:stream`.
+enum class EmbreeRayMode { kSingle, kPacket4, kPacket8, kPacket16, kStream };
 
 struct EmbreeOptions {
   EmbreeQuality quality = EmbreeQuality::kMedium;
@@ -32,7 +39,32 @@ struct EmbreeOptions {
   // `embree:hugepages` / `embree:no_hugepages`: this backend's memory policy
   // instead of the run's (BackendConfig::huge_pages).
   std::optional<bool> huge_pages;
+  EmbreeRayMode ray_mode = EmbreeRayMode::kSingle;
+  // `embree:...:incoherent`: RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT instead
+  // of COHERENT for packets and streams (an error for single rays, whose
+  // traversal does not read the flag).
+  bool incoherent = false;
 };
+
+// The rays per packet of a packet mode (4, 8, 16); 0 for single rays and streams.
+int embree_packet_width(EmbreeRayMode mode);
+
+// What Embree says it runs natively on a device (rtcGetDeviceProperty:
+// RTC_DEVICE_PROPERTY_NATIVE_RAY4/8/16_SUPPORTED, RAY_STREAM_SUPPORTED).
+struct EmbreeNativeRays {
+  bool packet4 = false, packet8 = false, packet16 = false, stream = false;
+};
+
+// The ray mode as the run's metadata records it (provenance.<backend>.ray_mode):
+// the mode, the calls, the context flag and whether Embree runs it natively,
+// e.g. "packet16 (rtcIntersect16/rtcOccluded16, coherent flag): native" or
+// "packet16 (...): emulated by Embree (no native 16-wide packets on this
+// device; native widths: 4, 8), its stream filter splits each packet".
+std::string embree_ray_mode(const EmbreeOptions& options, const EmbreeNativeRays& native);
+
+// The short form for the progress line: "packet16 native", "stream coherent",
+// "packet16 emulated"; "" for single rays.
+std::string embree_ray_mode_summary(const EmbreeOptions& options, const EmbreeNativeRays& native);
 
 // The ISA names Embree 3.13's device config accepts (state.cpp,
 // string_to_cpufeatures, less its aliases), in ascending order.
@@ -41,7 +73,8 @@ const std::vector<std::string>& embree_isa_names();
 // Parses the options after "embree" of `name` (e.g. {"high", "avx2"} of
 // "embree:high:avx2"). Throws InputError, one line naming `name`, for an
 // unknown option, one given twice, or two of one kind (two build qualities,
-// two frequency levels, two ISAs, hugepages with no_hugepages).
+// two frequency levels, two ISAs, hugepages with no_hugepages, two ray modes),
+// or `incoherent` without a packet or stream mode.
 EmbreeOptions parse_embree_options(const std::string& name, const std::vector<std::string>& options);
 
 // Whether the backend's structures get huge pages: its own option, else the run's policy.
