@@ -54,30 +54,39 @@ struct PacketPlan {
 };
 
 // Which of the `n` (<= kPacketRays) rays go together, by the rule above;
-// `r` are their Slab precomputations.
-inline PacketPlan plan_packet(const Ray* rays, const Slab::Precomputed* r, int n, float max_origin_distance) {
+// `r` receives the Slab precomputation of the rays in the packet. Cheap
+// tests first (the direction's signs, then squared lengths, no division or
+// root), so that an incoherent group costs a few comparisons per ray.
+inline PacketPlan plan_packet(const Ray* rays, Slab::Precomputed* r, int n, float max_origin_distance) {
   PacketPlan plan;
-  int lead = -1;
-  Vec3f lead_dir{};
-  for (int i = 0; i < n; ++i) {
-    if (!SlabFma::serves(r[i])) continue;
-    const float len = length(rays[i].dir);
-    if (!(len > 0.0f)) continue;
-    const Vec3f dir = rays[i].dir * (1.0f / len);
-    if (lead < 0) {
-      lead = i;
-      lead_dir = dir;
-      plan.octant = ray_octant(r[i]);
-      plan.lanes = 1u;
-      plan.lanes <<= i;
-      continue;
+  const auto signs = [](Vec3f d) {
+    return static_cast<int>(std::signbit(d.x)) | static_cast<int>(std::signbit(d.y)) << 1 |
+           static_cast<int>(std::signbit(d.z)) << 2;
+  };
+  constexpr float kMinCosine2 = kMinPacketCosine * kMinPacketCosine;
+  const float max_distance2 = max_origin_distance * max_origin_distance;
+  for (int lead = 0; lead + kMinPacketRays <= n; ++lead) {
+    r[lead] = Slab::precompute(rays[lead]);
+    if (!SlabFma::serves(r[lead])) continue;
+    const Vec3f lead_dir = rays[lead].dir, lead_org = rays[lead].org;
+    const float lead_len2 = dot(lead_dir, lead_dir);
+    const int octant = signs(lead_dir);
+    unsigned lanes = 1u << lead;
+    for (int i = lead + 1; i < n; ++i) {
+      const Vec3f d = rays[i].dir, o = rays[i].org - lead_org;
+      const float cosine = dot(d, lead_dir);
+      if (signs(d) != octant || !(cosine > 0.0f) || !(cosine * cosine >= kMinCosine2 * dot(d, d) * lead_len2) ||
+          !(dot(o, o) <= max_distance2))
+        continue;
+      r[i] = Slab::precompute(rays[i]);
+      if (SlabFma::serves(r[i])) lanes |= 1u << i;
     }
-    if (ray_octant(r[i]) != plan.octant || !(dot(dir, lead_dir) >= kMinPacketCosine) ||
-        !(length(rays[i].org - rays[lead].org) <= max_origin_distance))
-      continue;
-    plan.lanes |= 1u << i;
+    if (std::popcount(lanes) >= kMinPacketRays) {
+      plan.lanes = lanes;
+      plan.octant = ray_octant(r[lead]);
+    }
+    return plan;  // the first served ray leads, or no packet
   }
-  if (std::popcount(plan.lanes) < kMinPacketRays) plan.lanes = 0;
   return plan;
 }
 
@@ -312,7 +321,6 @@ inline void intersect_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, s
   for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
     const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
     Slab::Precomputed r[kPacketRays];
-    for (int i = 0; i < n; ++i) r[i] = Slab::precompute(rays[first + i]);
     const PacketPlan plan = bvh.nodes.empty() ? PacketPlan{} : plan_packet(&rays[first], r, n, max_origin_distance);
     for (int i = 0; i < n; ++i)
       if (!(plan.lanes >> i & 1u)) hits[first + i] = traverse_wide<false, Leaf, SlabFma, kSlots>(bvh, rays[first + i]);
@@ -334,7 +342,6 @@ inline void occluded_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, st
   for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
     const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
     Slab::Precomputed r[kPacketRays];
-    for (int i = 0; i < n; ++i) r[i] = Slab::precompute(rays[first + i]);
     const PacketPlan plan = bvh.nodes.empty() ? PacketPlan{} : plan_packet(&rays[first], r, n, max_origin_distance);
     for (int i = 0; i < n; ++i)
       if (!(plan.lanes >> i & 1u)) occluded[first + i] = occluded_wide<Leaf, SlabFma>(bvh, rays[first + i]);
