@@ -29,9 +29,9 @@ void append_analytic_seed_names(std::vector<BackendInfo>& out, std::string_view 
 BvhOptions parse_bvh_options(const std::string& name, std::string_view family, const std::vector<std::string>& options,
                              std::span<const std::string_view> tests, std::string_view example) {
   const std::string valid = fmt::format(
-      "triangle tests: {}; builders: {}; box tests: {}, {}; tree: {}; analytic primitives' seed tests: {}, {}, {}",
+      "triangle tests: {}; builders: {}; box tests: {}, {}; tree: {}; analytic primitives' seed tests: {}, {}, {}{}",
       fmt::join(tests, ", "), bvh2_builder_names(), kRobustBoxes, kPlainBoxes, kReinsertOption, kSphereSeed, kBoxSeed,
-      kObbSeed);
+      kObbSeed, family == "bvh8" ? fmt::format("; traversal: {}", kPacketTraversal) : std::string());
   BvhOptions out;
   for (const std::string& o : options) {
     const std::optional<Bvh2Builder> as_builder = parse_bvh2_builder(o);
@@ -41,6 +41,13 @@ BvhOptions parse_bvh_options(const std::string& name, std::string_view family, c
                        : o == kBoxSeed  ? &out.analytic.box_seed
                        : o == kObbSeed  ? &out.analytic.obb_seed
                                         : nullptr;
+    if (o == kPacketTraversal) {
+      if (family != "bvh8")
+        throw InputError("", fmt::format("backend '{}': the packet traversal is bvh8's only; use bvh8:{}", name, o));
+      if (out.packet) throw InputError("", fmt::format("backend '{}': option '{}' given twice", name, o));
+      out.packet = true;
+      continue;
+    }
     if (seed) {
       if (*seed) throw InputError("", fmt::format("backend '{}': option '{}' given twice", name, o));
       *seed = true;

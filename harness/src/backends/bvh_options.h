@@ -1,6 +1,7 @@
 // The options our BVH backends take after their family name (bvh2, bvh8,
 // bvh4): a triangle test, a builder (raybench/bvh/bvh2_builders.h), a box
-// test ('robust' or 'plain_boxes'), 'reinsert', and the seed-faithful tests
+// test ('robust' or 'plain_boxes'), 'reinsert', 'packet' (bvh8's packet
+// traversal of coherent rays), and the seed-faithful tests
 // of analytic primitives ('sphere_seed', 'box_seed', 'obb_seed': SphereSeed,
 // SlabSeed, ObbSeed instead of SpherePrecise, Slab, Obb in the leaves of a
 // scene with analytic primitives, raybench/bvh/mixed_leaf.h), each at most
@@ -34,12 +35,14 @@ inline constexpr std::string_view kPlainBoxes = "plain_boxes";
 inline constexpr std::string_view kSphereSeed = "sphere_seed";  // prim/sphere_seed.h's name
 inline constexpr std::string_view kBoxSeed = "box_seed";        // SlabSeed (prim/aabb_slab_seed.h) as the box primitives' test
 inline constexpr std::string_view kObbSeed = "obb_seed";        // prim/obb_seed.h's name
+inline constexpr std::string_view kPacketTraversal = "packet";  // bvh8 only: raybench/bvh/wide_bvh_packet.h
 
 struct BvhOptions {
   std::optional<std::string> test;  // one of the family's triangle tests, if named
   std::optional<Bvh2Builder> builder;
   std::optional<bool> robust_boxes;  // true: 'robust', false: 'plain_boxes'; unset: neither named
   bool reinsert = false;
+  bool packet = false;  // 'packet': coherent rays traced in packets (bvh8 only)
   AnalyticTestChoice analytic;  // the tests of analytic primitives (scenes that have them)
 
   Bvh2Builder builder_or_default() const { return builder.value_or(Bvh2Builder::kBinnedSah); }

@@ -209,8 +209,11 @@ std::unique_ptr<Backend> make_with_analytic(const std::string& name, const std::
   // Only the binned builder takes primitive boxes: with another the pair
   // models triangles only, and the run skips it on scenes with analytic
   // primitives (its build() of one refuses it).
-  const bool binned = parse(F, name, options).builder_or_default() == Bvh2Builder::kBinnedSah;
-  return std::make_unique<AnalyticDispatchBackend>(std::move(triangles), binned ? every_type() : Capabilities{},
+  // The packet traversal has no mixed form: bvh8:packet models triangles
+  // only, and the run skips it on such scenes with a note, as above.
+  const BvhOptions parsed = parse(F, name, options);
+  const bool analytic = parsed.builder_or_default() == Bvh2Builder::kBinnedSah && !parsed.packet;
+  return std::make_unique<AnalyticDispatchBackend>(std::move(triangles), analytic ? every_type() : Capabilities{},
                                                    [name, options] { return make_mixed(F, name, options); },
                                                    config.huge_pages);
 }

@@ -36,11 +36,14 @@
 #include "io/error.h"
 #include "raybench/bvh/bvh2_builders.h"
 #include "raybench/bvh/wide_bvh_batch.h"
+#include "raybench/bvh/wide_bvh_packet.h"
 
 namespace raybench {
 namespace {
 
-template <int W, typename Leaf, typename BoxTest>
+// Packet: intersect and occluded trace coherent rays in packets (8 wide,
+// SlabFma only).
+template <int W, typename Leaf, typename BoxTest, bool Packet = false>
 class WideBvhBackend final : public Backend {
  public:
   WideBvhBackend(std::string name, Bvh2Builder builder, int reinsertion_passes)
@@ -61,11 +64,13 @@ class WideBvhBackend final : public Backend {
 
   // The same code as the in-tree plugin wrapping bvh8 (bvh/wide_bvh_batch.h).
   void intersect(std::span<const Ray> rays, std::span<Hit> hits) const override {
-    intersect_wide_batch<Leaf, BoxTest>(bvh_, rays, hits);
+    if constexpr (Packet) intersect_packet_batch<Leaf>(bvh_, rays, hits);
+    else intersect_wide_batch<Leaf, BoxTest>(bvh_, rays, hits);
   }
 
   void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override {
-    occluded_wide_batch<Leaf, BoxTest>(bvh_, rays, occluded);
+    if constexpr (Packet) occluded_packet_batch<Leaf>(bvh_, rays, occluded);
+    else occluded_wide_batch<Leaf, BoxTest>(bvh_, rays, occluded);
   }
 
  private:
@@ -77,7 +82,15 @@ class WideBvhBackend final : public Backend {
 
 template <int W, typename Leaf>
 std::unique_ptr<Backend> make_with_box_test(const std::string& name, Bvh2Builder builder, int reinsertion_passes,
-                                            bool robust) {
+                                            bool robust, bool packet) {
+  if constexpr (W == 8) {
+    if (packet) {
+      if (robust)
+        throw InputError("", fmt::format("backend '{}': the packet traversal takes the plain box test only (slab_fma); "
+                                         "add :{}", name, kPlainBoxes));
+      return std::make_unique<WideBvhBackend<8, Leaf, SlabFma, true>>(name, builder, reinsertion_passes);
+    }
+  }
   if (robust) return std::make_unique<WideBvhBackend<W, Leaf, SlabRobustRay>>(name, builder, reinsertion_passes);
   return std::make_unique<WideBvhBackend<W, Leaf, SlabFma>>(name, builder, reinsertion_passes);
 }
@@ -95,10 +108,10 @@ std::unique_ptr<Backend> make_wide_backend(const std::string& name, const std::v
   const Bvh2Builder b = parsed.builder_or_default();
   const int passes = parsed.reinsertion_passes();
   if constexpr (W == 8) {
-    if (parsed.test == kWatertightTest) return make_with_box_test<8, Bvh8Watertight>(name, b, passes, parsed.robust());
+    if (parsed.test == kWatertightTest) return make_with_box_test<8, Bvh8Watertight>(name, b, passes, parsed.robust(), parsed.packet);
   }
-  if (parsed.test.value_or("mt") == "mt_edges") return make_with_box_test<W, WideMollerTrumboreEdges>(name, b, passes, parsed.robust());
-  return make_with_box_test<W, WideMollerTrumbore>(name, b, passes, parsed.robust());
+  if (parsed.test.value_or("mt") == "mt_edges") return make_with_box_test<W, WideMollerTrumboreEdges>(name, b, passes, parsed.robust(), parsed.packet);
+  return make_with_box_test<W, WideMollerTrumbore>(name, b, passes, parsed.robust(), parsed.packet);
 }
 
 template <int W>
@@ -133,6 +146,12 @@ std::vector<BackendInfo> wide_backend_names() {
                    "the same as bvh8:watertight (its name until the watertight leaves took the conservative box test by "
                    "default)",
                    "watertight"});
+  }
+  if constexpr (W == 8) {
+    out.push_back({"bvh8:packet",
+                   "bvh8 tracing coherent consecutive rays in packets of 8 (a frustum test per node, per-ray masks, "
+                   "single rays where rays diverge), the same answers as bvh8 bit for bit; triangle scenes only; "
+                   "any bvh8 name with the plain box test takes :packet"});
   }
   out.push_back({family + ":robust", fmt::format("{} with the conservative {}-wide box test (slab_robust_ray); any {} "
                                                  "name takes :robust or :plain_boxes (slab_fma, the default) for its box test",

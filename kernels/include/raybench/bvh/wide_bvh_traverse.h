@@ -178,9 +178,14 @@ struct Bvh8Watertight {
 // for the caller to map through pack_prims once its rays are all traced:
 // there, independent loads overlap; inside the traversal each could miss and
 // hold it up (measured: docs/notes/kernels-wide-traversal.md).
+// traverse_wide_from continues a ray's traversal in the subtree `start` (a
+// node or kLeafBit | pack) with the closest hit found so far, `hit` (none:
+// the default Hit; its t is then the ray's tfar): what the packet traversal
+// (wide_bvh_packet.h) hands a ray to when its packet thins out. From the
+// root with no hit it is traverse_wide itself.
 template <bool AnyHit, typename Leaf = WideMollerTrumbore, typename BoxTest = SlabFma, bool PackSlots = false, int W>
-RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
-  Hit hit;
+RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide_from(const WideBvh<W>& bvh, const Ray& ray,
+                                                                         std::uint32_t start, Hit hit) {
   if (bvh.nodes.empty()) {
     if constexpr (AnyHit) return false;
     else return hit;
@@ -191,7 +196,8 @@ RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide(const WideBv
   // SlabRobustRay rays with tnear >= 0 (the others pad every exit): the
   // whole traversal runs with the test the ray gets.
   if constexpr (HasFallback<BoxTest>)
-    if (!BoxTest::serves(r)) return traverse_wide<AnyHit, Leaf, typename BoxTest::Fallback, PackSlots>(bvh, ray);
+    if (!BoxTest::serves(r))
+      return traverse_wide_from<AnyHit, Leaf, typename BoxTest::Fallback, PackSlots>(bvh, ray, start, hit);
   const int octant = ray_octant(r);
 #if defined(__AVX2__)
   const RayLanes<W> ray_lanes = RayLanes<W>::template from<BoxTest>(r, bvh.bounds);
@@ -204,7 +210,7 @@ RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide(const WideBv
     if constexpr (BoxTest::accuracy == AccuracyClass::kConservative) return SlabRobust::padded(tmax);
     else return tmax;
   };
-  float tmax = ray.tfar;
+  float tmax = hit.hit() ? hit.t : ray.tfar;
   // Both bounds change with tmax only, at a hit: set there, not per node
   // (the padding alone is five scalar operations).
   float reach = reach_bound(tmax);
@@ -213,7 +219,7 @@ RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide(const WideBv
 #endif
   wide_bvh_detail::Stack<W> stack;
   stack.top = 0;
-  std::uint32_t ref = 0;  // the node or leaf visited next: the root first
+  std::uint32_t ref = start;  // the node or leaf visited next
   for (;;) {
     if (ref & WideBvh<W>::kLeafBit) {
       const std::uint32_t pack = ref & ~WideBvh<W>::kLeafBit;
@@ -282,6 +288,11 @@ RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide(const WideBv
     } while (!AnyHit && !(stack.entry[stack.top] <= reach));
     ref = stack.ref[stack.top];
   }
+}
+
+template <bool AnyHit, typename Leaf = WideMollerTrumbore, typename BoxTest = SlabFma, bool PackSlots = false, int W>
+RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide(const WideBvh<W>& bvh, const Ray& ray) {
+  return traverse_wide_from<AnyHit, Leaf, BoxTest, PackSlots>(bvh, ray, 0, Hit{});
 }
 
 template <typename Leaf = WideMollerTrumbore, typename BoxTest = SlabFma, int W>

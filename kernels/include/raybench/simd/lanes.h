@@ -69,6 +69,7 @@ struct FloatLanes<8> {
   FloatLanes operator*(FloatLanes o) const { return {_mm256_mul_ps(v, o.v)}; }
   FloatLanes operator/(FloatLanes o) const { return {_mm256_div_ps(v, o.v)}; }
   FloatLanes operator&(FloatLanes o) const { return {_mm256_and_ps(v, o.v)}; }
+  FloatLanes operator|(FloatLanes o) const { return {_mm256_or_ps(v, o.v)}; }
   FloatLanes operator^(FloatLanes o) const { return {_mm256_xor_ps(v, o.v)}; }
   FloatLanes operator<=(FloatLanes o) const { return {_mm256_cmp_ps(v, o.v, _CMP_LE_OQ)}; }
   FloatLanes operator<(FloatLanes o) const { return {_mm256_cmp_ps(v, o.v, _CMP_LT_OQ)}; }
@@ -124,6 +125,7 @@ struct FloatLanes<4> {
   FloatLanes operator*(FloatLanes o) const { return {_mm_mul_ps(v, o.v)}; }
   FloatLanes operator/(FloatLanes o) const { return {_mm_div_ps(v, o.v)}; }
   FloatLanes operator&(FloatLanes o) const { return {_mm_and_ps(v, o.v)}; }
+  FloatLanes operator|(FloatLanes o) const { return {_mm_or_ps(v, o.v)}; }
   FloatLanes operator^(FloatLanes o) const { return {_mm_xor_ps(v, o.v)}; }
   FloatLanes operator<=(FloatLanes o) const { return {_mm_cmp_ps(v, o.v, _CMP_LE_OQ)}; }
   FloatLanes operator<(FloatLanes o) const { return {_mm_cmp_ps(v, o.v, _CMP_LT_OQ)}; }

@@ -1,0 +1,355 @@
+// Packets of up to 8 coherent rays traced together through a Bvh8, closest
+// hit and any hit, with exactly the answers of the single-ray traversal
+// (wide_bvh_traverse.h): the `bvh8:packet` backends.
+// Algorithm: a packet visits a node once for all its rays (Wald, Slusallek,
+// Benthin & Wagner, "Interactive Rendering with Coherent Ray Tracing", EG
+// 2001). A conservative frustum test first picks the children any ray of
+// the packet may enter, with one 8-wide test: interval bounds over the
+// packet's reciprocal directions and origins, padded beyond every rounding
+// error (the packet frustum of Wald, Boulos & Shirley, "Ray Tracing Deformable
+// Scenes Using Dynamic Bounding Volume Hierarchies", TOG 2007; Embree's
+// node_intersector_frustum.h). Each picked child is then tested against
+// every ray at once with the single-ray box test's own operations in the
+// same order, so each ray's lane is active in exactly the subtrees its own
+// traversal enters. Children are visited in the node's far-to-near order
+// for the packet's octant (closest hit) or in lane order (any hit), the
+// orders each ray uses alone, and a popped subtree is skipped for a ray when
+// it is farther than that ray's closest hit: every ray meets its leaves in
+// its own order and keeps the same ties. Leaves are tested ray by ray with
+// the single-ray leaf test. A subtree left with one active ray is traced
+// for it alone (traverse_wide_from), as Embree's hybrid traversal turns to
+// single rays (bvh_intersector_hybrid.cpp).
+// Grouping: each run of up to 8 consecutive rays is a packet of those that
+// share the first served ray's octant, take the fused box test (no zero
+// direction component: SlabFma::serves), point within kMinPacketCosine of
+// its direction and start within kMaxPacketOriginSpread of its origin; the
+// others, and a group with fewer than kMinPacketRays such rays, are traced
+// alone. Incoherent ray sets (diffuse, uniform) so run the single-ray
+// traversal, at the cost of the check.
+// Guarantee: every ray's answer is traverse_wide's for the same ray, the Hit
+// bit for bit and the occlusion bit, whatever the grouping (tested:
+// kernels/tests/wide_bvh_packet_test.cpp). The box test is SlabFma's.
+#pragma once
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <span>
+
+#include "raybench/bvh/wide_bvh_traverse.h"
+
+namespace raybench {
+
+inline constexpr int kPacketRays = 8;  // AVX2's float lanes: one ray per lane
+inline constexpr int kMinPacketRays = 3;
+inline constexpr float kMinPacketCosine = 0.99f;         // directions within about 8 degrees of the first ray's
+inline constexpr float kMaxPacketOriginSpread = 0.02f;  // of the tree's bounds diagonal
+
+// The rays of a group traced as one packet (bit i: ray i of the group), and
+// their shared octant; lanes == 0: every ray alone.
+struct PacketPlan {
+  unsigned lanes = 0;
+  int octant = 0;
+};
+
+// Which of the `n` (<= kPacketRays) rays go together, by the rule above;
+// `r` receives the Slab precomputation of the rays in the packet. Cheap
+// tests first (the direction's signs, then squared lengths, no division or
+// root), so that an incoherent group costs a few comparisons per ray.
+inline PacketPlan plan_packet(const Ray* rays, Slab::Precomputed* r, int n, float max_origin_distance) {
+  PacketPlan plan;
+  const auto signs = [](Vec3f d) {
+    return static_cast<int>(std::signbit(d.x)) | static_cast<int>(std::signbit(d.y)) << 1 |
+           static_cast<int>(std::signbit(d.z)) << 2;
+  };
+  constexpr float kMinCosine2 = kMinPacketCosine * kMinPacketCosine;
+  const float max_distance2 = max_origin_distance * max_origin_distance;
+  for (int lead = 0; lead + kMinPacketRays <= n; ++lead) {
+    r[lead] = Slab::precompute(rays[lead]);
+    if (!SlabFma::serves(r[lead])) continue;
+    const Vec3f lead_dir = rays[lead].dir, lead_org = rays[lead].org;
+    const float lead_len2 = dot(lead_dir, lead_dir);
+    const int octant = signs(lead_dir);
+    unsigned lanes = 1u << lead;
+    for (int i = lead + 1; i < n; ++i) {
+      const Vec3f d = rays[i].dir, o = rays[i].org - lead_org;
+      const float cosine = dot(d, lead_dir);
+      if (signs(d) != octant || !(cosine > 0.0f) || !(cosine * cosine >= kMinCosine2 * dot(d, d) * lead_len2) ||
+          !(dot(o, o) <= max_distance2))
+        continue;
+      r[i] = Slab::precompute(rays[i]);
+      if (SlabFma::serves(r[i])) lanes |= 1u << i;
+    }
+    if (std::popcount(lanes) >= kMinPacketRays) {
+      plan.lanes = lanes;
+      plan.octant = ray_octant(r[lead]);
+    }
+    return plan;  // the first served ray leads, or no packet
+  }
+  return plan;
+}
+
+#if defined(__AVX2__)
+namespace wide_packet_detail {
+
+using F = simd::FloatLanes<kPacketRays>;
+
+inline F all_ones() { return F::set1(std::bit_cast<float>(0xffffffffu)); }
+
+// The packet's rays lane by lane as the single-ray box test reads each
+// (RayLanes<8>::from<SlabFma>: 1/d and the fused offset o/d), and the
+// frustum: per axis the bounds of 1/d and of o/d over the packet, widened by
+// a padding that covers the rounding of both the per-ray distances and the
+// interval's own (16 times the worst case: 3 half-ulps of the largest term).
+struct Packet {
+  F inv_dir[3], fused[3], tnear;
+  int near_offset[3];  // the shared octant's entry planes (RayLanes::near_offset)
+  F inv_lo[3], inv_hi[3], fused_hi[3], fused_lo[3];
+  F tnear_min, exit_max;
+};
+
+inline Packet make_packet(const Slab::Precomputed* r, const Ray* rays, unsigned lanes, const BBox& extent) {
+  Packet p;
+  alignas(32) float inv[3][kPacketRays], fused[3][kPacketRays], tnear[kPacketRays];
+  const int lead = std::countr_zero(lanes);
+  float tnear_min = std::numeric_limits<float>::infinity(), exit_max = -std::numeric_limits<float>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    float inv_lo = std::numeric_limits<float>::infinity(), inv_hi = -inv_lo, fused_lo = inv_lo, fused_hi = -inv_lo,
+          fused_abs = 0.0f;
+    for (int i = 0; i < kPacketRays; ++i) {
+      const int k = lanes >> i & 1u ? i : lead;  // lanes outside the packet repeat its first ray
+      inv[a][i] = r[k].inv_dir[a];
+      fused[a][i] = r[k].org[a] * r[k].inv_dir[a];  // as RayLanes::from rounds it
+      inv_lo = std::min(inv_lo, inv[a][i]);
+      inv_hi = std::max(inv_hi, inv[a][i]);
+      fused_lo = std::min(fused_lo, fused[a][i]);
+      fused_hi = std::max(fused_hi, fused[a][i]);
+      fused_abs = std::max(fused_abs, std::fabs(fused[a][i]));
+    }
+    const float plane_abs = std::max(std::fabs(extent.lower[a]), std::fabs(extent.upper[a]));
+    const float pad = 0x1p-20f * (plane_abs * std::max(std::fabs(inv_lo), std::fabs(inv_hi)) + fused_abs);
+    p.inv_dir[a] = F::load(inv[a]);
+    p.fused[a] = F::load(fused[a]);
+    p.inv_lo[a] = F::set1(inv_lo);
+    p.inv_hi[a] = F::set1(inv_hi);
+    p.fused_hi[a] = F::set1(fused_hi + pad);
+    p.fused_lo[a] = F::set1(fused_lo - pad);
+    p.near_offset[a] = r[lead].negative[a] ? 3 * kPacketRays : 0;
+  }
+  for (int i = 0; i < kPacketRays; ++i) {
+    const int k = lanes >> i & 1u ? i : lead;
+    tnear[i] = r[k].tnear;
+    tnear_min = std::min(tnear_min, r[k].tnear);
+    exit_max = std::max(exit_max, box_exit_bound<SlabFma>(rays[k].tfar));
+  }
+  p.tnear = F::load(tnear);
+  p.tnear_min = F::set1(tnear_min);
+  p.exit_max = F::set1(exit_max);
+  return p;
+}
+
+// The children of `node` some ray of the packet may enter (bit i: lane i);
+// never fewer than the exact tests enter. A NaN anywhere keeps the child.
+inline unsigned frustum_children(const Packet& p, const WideNode<8>& node) {
+  const float* planes = reinterpret_cast<const float*>(&node.bounds);
+  F entry = p.tnear_min, exit = p.exit_max;
+  for (int a = 0; a < 3; ++a) {
+    const F near_plane = F::load(planes + a * 8 + p.near_offset[a]);
+    const F far_plane = F::load(planes + a * 8 + (24 - p.near_offset[a]));
+    // max/min keep their second operand (the bound so far) when the first is NaN.
+    entry = max(min(near_plane * p.inv_lo[a], near_plane * p.inv_hi[a]) - p.fused_hi[a], entry);
+    exit = min(max(far_plane * p.inv_lo[a], far_plane * p.inv_hi[a]) - p.fused_lo[a], exit);
+  }
+  return ~(entry > exit).mask() & 0xffu;
+}
+
+// Child `lane` of `node` against every ray, as slab_lanes<SlabFma> computes
+// it for each: `node_tnear` is the rays' tnear in the lanes active at the
+// node and NaN in the others (max keeps NaN, so they miss), `exit` their
+// box_exit_bound. Returns the hit lanes; `entry` gets their entry distances
+// and NaN in the other lanes.
+RAYBENCH_INLINE unsigned child_hits(const Packet& p, const WideNode<8>& node, int lane, F node_tnear, F exit, F& entry) {
+  const float* planes = reinterpret_cast<const float*>(&node.bounds);
+  F t_entry = node_tnear, t_exit = exit;
+  for (int a = 0; a < 3; ++a) {
+    const F near_plane = F::set1(planes[a * 8 + p.near_offset[a] + lane]);
+    const F far_plane = F::set1(planes[a * 8 + (24 - p.near_offset[a]) + lane]);
+    t_entry = max(fmsub(near_plane, p.inv_dir[a], p.fused[a]), t_entry);
+    t_exit = min(fmsub(far_plane, p.inv_dir[a], p.fused[a]), t_exit);
+  }
+  const F hit = t_entry <= t_exit;
+  entry = t_entry | (hit ^ all_ones());
+  return hit.mask();
+}
+
+// The traversal stack: a subtree and each ray's entry distance into it (NaN
+// for the rays that do not enter it).
+struct PacketStack {
+  static constexpr std::size_t kSize = 8 * wide_bvh_detail::kMaxDepth + 8;
+  alignas(32) float entry[kSize][kPacketRays];
+  std::uint32_t ref[kSize];
+  int top = 0;
+};
+
+}  // namespace wide_packet_detail
+
+// Traces the rays of `plan` among rays[0..7] as one packet; `r` are their
+// Slab precomputations. Closest hit: hits[i] for each ray i of the plan (the
+// pack slot as prim with PackSlots, as traverse_wide). Any hit: occluded[i].
+template <bool AnyHit, typename Leaf, bool PackSlots>
+void trace_packet(const Bvh8& bvh, const Ray* rays, const Slab::Precomputed* r, PacketPlan plan, Hit* hits,
+                  std::uint8_t* occluded) {
+  using namespace wide_packet_detail;
+  const Packet p = make_packet(r, rays, plan.lanes, bvh.bounds);
+  typename Leaf::RayData leaf_ray[kPacketRays];
+  alignas(32) float tmax[kPacketRays];
+  Hit hit[kPacketRays];
+  for (int i = 0; i < kPacketRays; ++i) {
+    tmax[i] = rays[i].tfar;
+    if (plan.lanes >> i & 1u) leaf_ray[i] = Leaf::precompute(rays[i]);
+  }
+  constexpr float kLargest = std::numeric_limits<float>::max();
+  const float kDone = -std::numeric_limits<float>::infinity();  // an occluded ray's tmax: it enters nothing more
+  F reach = F::load(tmax);  // SlabFma is not conservative: a subtree is skipped when farther than tmax
+  F exit = min(reach, F::set1(kLargest));
+  PacketStack stack;
+  std::uint32_t ref = 0;
+  unsigned active = plan.lanes;
+  F node_tnear;  // tnear in the lanes active at the node, NaN in the others
+  {
+    alignas(32) float outside[kPacketRays];
+    for (int i = 0; i < kPacketRays; ++i) outside[i] = plan.lanes >> i & 1u ? 0.0f : std::bit_cast<float>(0xffffffffu);
+    node_tnear = p.tnear | F::load(outside);
+  }
+  const auto update_bounds = [&] {
+    reach = F::load(tmax);
+    exit = min(reach, F::set1(kLargest));
+  };
+  for (;;) {
+    if (std::popcount(active) == 1) {
+      // One ray left in this subtree: it goes on alone from here.
+      const int i = std::countr_zero(active);
+      if constexpr (AnyHit) {
+        if (traverse_wide_from<true, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, Hit{})) {
+          occluded[i] = 1;
+          tmax[i] = kDone;
+          update_bounds();
+        }
+      } else {
+        hit[i] = traverse_wide_from<false, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, hit[i]);
+        if (hit[i].hit()) {
+          tmax[i] = hit[i].t;
+          update_bounds();
+        }
+      }
+    } else if (ref & Bvh8::kLeafBit) {
+      const std::uint32_t pack = ref & ~Bvh8::kLeafBit;
+      bool any = false;
+      for (unsigned lanes = active; lanes; lanes &= lanes - 1) {
+        const int i = std::countr_zero(lanes);
+        TriangleHit th{};
+        const int lane = Leaf::intersect(leaf_ray[i], tmax[i], bvh, pack, th);
+        if (lane < 0) continue;
+        any = true;
+        if constexpr (AnyHit) {
+          occluded[i] = 1;
+          tmax[i] = kDone;
+        } else {
+          tmax[i] = th.t;
+          if constexpr (PackSlots) hit[i] = {th.t, static_cast<std::int32_t>(Bvh8::slot(pack, lane)), th.u, th.v};
+          else hit[i] = {th.t, Leaf::prim(bvh, pack, lane), th.u, th.v};
+        }
+      }
+      if (any) update_bounds();
+    } else {
+      const WideNode<8>& node = bvh.nodes[ref];
+      F child_entry[8];
+      unsigned entered = 0;
+      for (unsigned lanes = frustum_children(p, node); lanes; lanes &= lanes - 1) {
+        const int lane = std::countr_zero(lanes);
+        if (child_hits(p, node, lane, node_tnear, exit, child_entry[lane])) entered |= 1u << lane;
+      }
+      const auto push = [&](int lane) {
+        child_entry[lane].storeu(stack.entry[stack.top]);
+        stack.ref[stack.top] = node.child[lane];
+        ++stack.top;
+      };
+      if constexpr (AnyHit) {
+        for (unsigned lanes = entered; lanes; lanes &= lanes - 1) push(std::countr_zero(lanes));
+      } else {
+        for (int rank = 0; rank < 8; ++rank) {
+          const int lane = far_to_near_lane(node, plan.octant, rank);
+          if (entered >> lane & 1u) push(lane);
+        }
+      }
+    }
+    // Pop the next subtree some ray still reaches.
+    for (;;) {
+      if (stack.top == 0) {
+        for (unsigned lanes = plan.lanes; lanes; lanes &= lanes - 1) {
+          const int i = std::countr_zero(lanes);
+          if constexpr (AnyHit) {
+            if (tmax[i] != kDone) occluded[i] = 0;
+          } else {
+            hits[i] = hit[i];
+          }
+        }
+        return;
+      }
+      --stack.top;
+      const F within = F::load(stack.entry[stack.top]) <= reach;
+      active = within.mask();
+      if (active) {
+        ref = stack.ref[stack.top];
+        node_tnear = p.tnear | (within ^ all_ones());
+        break;
+      }
+    }
+  }
+}
+#endif
+
+// Closest hit of every ray, consecutive coherent rays traced as packets
+// (plan_packet), the others alone: the same Hit for every ray as
+// intersect_wide_batch. Screened rays, as wide_bvh_batch.h's loops.
+template <typename Leaf>
+inline void intersect_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, std::span<Hit> hits) {
+  constexpr bool kSlots = !Leaf::kPrimsInPack;
+#if defined(__AVX2__)
+  const float max_origin_distance = bvh.nodes.empty() ? 0.0f : kMaxPacketOriginSpread * length(bvh.bounds.extent());
+  for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
+    const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
+    Slab::Precomputed r[kPacketRays];
+    const PacketPlan plan = bvh.nodes.empty() ? PacketPlan{} : plan_packet(&rays[first], r, n, max_origin_distance);
+    for (int i = 0; i < n; ++i)
+      if (!(plan.lanes >> i & 1u)) hits[first + i] = traverse_wide<false, Leaf, SlabFma, kSlots>(bvh, rays[first + i]);
+    if (plan.lanes) trace_packet<false, Leaf, kSlots>(bvh, &rays[first], r, plan, &hits[first], nullptr);
+  }
+#else
+  for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = traverse_wide<false, Leaf, SlabFma, kSlots>(bvh, rays[i]);
+#endif
+  if constexpr (kSlots)
+    for (Hit& h : hits)
+      if (h.hit()) h.prim = bvh.pack_prims[static_cast<std::uint32_t>(h.prim)];
+}
+
+// Any hit of every ray, as occluded_wide_batch, packets as above.
+template <typename Leaf>
+inline void occluded_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, std::span<std::uint8_t> occluded) {
+#if defined(__AVX2__)
+  const float max_origin_distance = bvh.nodes.empty() ? 0.0f : kMaxPacketOriginSpread * length(bvh.bounds.extent());
+  for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
+    const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
+    Slab::Precomputed r[kPacketRays];
+    const PacketPlan plan = bvh.nodes.empty() ? PacketPlan{} : plan_packet(&rays[first], r, n, max_origin_distance);
+    for (int i = 0; i < n; ++i)
+      if (!(plan.lanes >> i & 1u)) occluded[first + i] = occluded_wide<Leaf, SlabFma>(bvh, rays[first + i]);
+    if (plan.lanes) trace_packet<true, Leaf, false>(bvh, &rays[first], r, plan, nullptr, &occluded[first]);
+  }
+#else
+  for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = occluded_wide<Leaf, SlabFma>(bvh, rays[i]);
+#endif
+}
+
+}  // namespace raybench
