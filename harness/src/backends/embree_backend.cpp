@@ -499,7 +499,7 @@ class EmbreeBackend final : public Backend {
   // FLT_LARGE, |tnear|, |tfar| <= inf, tnear >= 0) and finds nothing in an
   // empty interval, leaving tfar as it came.
   void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override {
-    switch (options_.ray_mode) {
+    switch (coherent_guarded_mode(rays)) {
       case EmbreeRayMode::kPacket4: return occluded_packets<4>(rays, occluded);
       case EmbreeRayMode::kPacket8: return occluded_packets<8>(rays, occluded);
       case EmbreeRayMode::kPacket16: return occluded_packets<16>(rays, occluded);
@@ -519,9 +519,28 @@ class EmbreeBackend final : public Backend {
   }
 
  private:
+  // The ray mode for this chunk. Debian's Embree, built with assertions,
+  // aborts in its coherent packet traversal (bvh_intersector_hybrid.cpp,
+  // occludedCoherent: `child != BVH::emptyNode`) when one packet holds
+  // directions of very different lengths (1e-20 beside 1e-7: the
+  // direction-scaling set, G16). A chunk with a direction length outside
+  // [2^-10, 2^10] is traced ray by ray, as `embree` (the same answers);
+  // the check is a few operations per ray, with no branch per ray. Renderers'
+  // rays (unit directions) never take that path.
+  EmbreeRayMode coherent_guarded_mode(std::span<const Ray> rays) const {
+    if (options_.ray_mode == EmbreeRayMode::kSingle || options_.incoherent) return options_.ray_mode;
+    float shortest = std::numeric_limits<float>::infinity(), longest = 0.0f;
+    for (const Ray& r : rays) {
+      const float length2 = r.dir.x * r.dir.x + r.dir.y * r.dir.y + r.dir.z * r.dir.z;
+      shortest = std::min(shortest, length2);
+      longest = std::max(longest, length2);
+    }
+    return shortest >= 0x1p-20f && longest <= 0x1p20f ? options_.ray_mode : EmbreeRayMode::kSingle;
+  }
+
   template <bool Analytic>
   void intersect_in_mode(std::span<const Ray> rays, std::span<Hit> hits) const {
-    switch (options_.ray_mode) {
+    switch (coherent_guarded_mode(rays)) {
       case EmbreeRayMode::kPacket4: return intersect_packets<4, Analytic>(rays, hits);
       case EmbreeRayMode::kPacket8: return intersect_packets<8, Analytic>(rays, hits);
       case EmbreeRayMode::kPacket16: return intersect_packets<16, Analytic>(rays, hits);
