@@ -200,7 +200,10 @@ TEST(WideBvhPacket, CoherentBlocksFormPacketsAndScatteredRaysDoNot) {
     return static_cast<double>(in_packets) / static_cast<double>(rays.size());
   };
   const std::vector<Ray> camera = camera_rays({0.5f, 0.3f, 9.0f}, 64, 48);
-  EXPECT_GT(packet_rays(camera), 0.95);
+  // Not all: groups across the image's middle row and column straddle two
+  // octants, and this coarse camera (0.75 degrees per pixel) spreads a
+  // 16-ray group over 6 degrees.
+  EXPECT_GT(packet_rays(camera), 0.9);
   EXPECT_LT(packet_rays(camera), 1.0);  // the middle column's rays, x = 0, go alone
   EXPECT_EQ(packet_rays(testing::rays_at(tris, "inside", 4096, 3)), 0.0);
   EXPECT_LT(packet_rays(testing::rays_at(tris, "random", 4096, 3)), 0.01);

@@ -31,6 +31,7 @@
 // kernels/tests/wide_bvh_packet_test.cpp). The box test is SlabFma's.
 #pragma once
 
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -41,7 +42,12 @@
 
 namespace raybench {
 
-inline constexpr int kPacketRays = 8;  // AVX2's float lanes: one ray per lane
+// Rays per packet, one per float lane: AVX-512's 16 (FloatLanes<16>) or AVX2's 8.
+#if defined(RAYBENCH_AVX512)
+inline constexpr int kPacketRays = 16;
+#else
+inline constexpr int kPacketRays = 8;
+#endif
 inline constexpr int kMinPacketRays = 3;
 inline constexpr float kMinPacketCosine = 0.99f;         // directions within about 8 degrees of the first ray's
 inline constexpr float kMaxPacketOriginSpread = 0.02f;  // of the tree's bounds diagonal
@@ -93,32 +99,39 @@ inline PacketPlan plan_packet(const Ray* rays, Slab::Precomputed* r, int n, floa
 #if defined(__AVX2__)
 namespace wide_packet_detail {
 
-using F = simd::FloatLanes<kPacketRays>;
+using F = simd::FloatLanes<kPacketRays>;  // one ray per lane
+using F8 = simd::FloatLanes<8>;           // a node's 8 children
 
-inline F all_ones() { return F::set1(std::bit_cast<float>(0xffffffffu)); }
+inline F nan_lanes() { return F::set1(std::numeric_limits<float>::quiet_NaN()); }
 
-// The packet's rays lane by lane as the single-ray box test reads each
-// (RayLanes<8>::from<SlabFma>: 1/d and the fused offset o/d), and the
-// frustum: per axis the bounds of 1/d and of o/d over the packet, widened by
-// a padding that covers the rounding of both the per-ray distances and the
-// interval's own (16 times the worst case: 3 half-ulps of the largest term).
+// The packet's rays lane by lane as the single-ray tests read each (the box
+// test: 1/d and the fused offset o/d of RayLanes<8>::from<SlabFma>; the
+// triangle test: origin, direction, tnear), and the frustum: per axis the
+// bounds of 1/d and of o/d over the packet, widened by a padding that
+// covers the rounding of both the per-ray distances and the interval's own
+// (16 times the worst case: 3 half-ulps of the largest term).
 struct Packet {
+  std::array<F, 3> org, dir;
   F inv_dir[3], fused[3], tnear;
   int near_offset[3];  // the shared octant's entry planes (RayLanes::near_offset)
-  F inv_lo[3], inv_hi[3], fused_hi[3], fused_lo[3];
-  F tnear_min, exit_max;
+  F8 inv_lo[3], inv_hi[3], fused_hi[3], fused_lo[3];
+  F8 tnear_min, exit_max;
 };
 
 inline Packet make_packet(const Slab::Precomputed* r, const Ray* rays, unsigned lanes, const BBox& extent) {
   Packet p;
-  alignas(32) float inv[3][kPacketRays], fused[3][kPacketRays], tnear[kPacketRays];
+  alignas(64) float org[3][kPacketRays], dir[3][kPacketRays], inv[3][kPacketRays], fused[3][kPacketRays],
+      tnear[kPacketRays];
   const int lead = std::countr_zero(lanes);
+  const auto ray_of = [&](int i) { return lanes >> i & 1u ? i : lead; };  // lanes outside the packet repeat its first ray
   float tnear_min = std::numeric_limits<float>::infinity(), exit_max = -std::numeric_limits<float>::infinity();
   for (int a = 0; a < 3; ++a) {
     float inv_lo = std::numeric_limits<float>::infinity(), inv_hi = -inv_lo, fused_lo = inv_lo, fused_hi = -inv_lo,
           fused_abs = 0.0f;
     for (int i = 0; i < kPacketRays; ++i) {
-      const int k = lanes >> i & 1u ? i : lead;  // lanes outside the packet repeat its first ray
+      const int k = ray_of(i);
+      org[a][i] = rays[k].org[a];
+      dir[a][i] = rays[k].dir[a];
       inv[a][i] = r[k].inv_dir[a];
       fused[a][i] = r[k].org[a] * r[k].inv_dir[a];  // as RayLanes::from rounds it
       inv_lo = std::min(inv_lo, inv[a][i]);
@@ -129,23 +142,25 @@ inline Packet make_packet(const Slab::Precomputed* r, const Ray* rays, unsigned 
     }
     const float plane_abs = std::max(std::fabs(extent.lower[a]), std::fabs(extent.upper[a]));
     const float pad = 0x1p-20f * (plane_abs * std::max(std::fabs(inv_lo), std::fabs(inv_hi)) + fused_abs);
+    p.org[a] = F::load(org[a]);
+    p.dir[a] = F::load(dir[a]);
     p.inv_dir[a] = F::load(inv[a]);
     p.fused[a] = F::load(fused[a]);
-    p.inv_lo[a] = F::set1(inv_lo);
-    p.inv_hi[a] = F::set1(inv_hi);
-    p.fused_hi[a] = F::set1(fused_hi + pad);
-    p.fused_lo[a] = F::set1(fused_lo - pad);
-    p.near_offset[a] = r[lead].negative[a] ? 3 * kPacketRays : 0;
+    p.inv_lo[a] = F8::set1(inv_lo);
+    p.inv_hi[a] = F8::set1(inv_hi);
+    p.fused_hi[a] = F8::set1(fused_hi + pad);
+    p.fused_lo[a] = F8::set1(fused_lo - pad);
+    p.near_offset[a] = r[lead].negative[a] ? 3 * 8 : 0;
   }
   for (int i = 0; i < kPacketRays; ++i) {
-    const int k = lanes >> i & 1u ? i : lead;
-    tnear[i] = r[k].tnear;
-    tnear_min = std::min(tnear_min, r[k].tnear);
+    const int k = ray_of(i);
+    tnear[i] = rays[k].tnear;  // = r[k].tnear: the packet's rays are finite
+    tnear_min = std::min(tnear_min, tnear[i]);
     exit_max = std::max(exit_max, box_exit_bound<SlabFma>(rays[k].tfar));
   }
   p.tnear = F::load(tnear);
-  p.tnear_min = F::set1(tnear_min);
-  p.exit_max = F::set1(exit_max);
+  p.tnear_min = F8::set1(tnear_min);
+  p.exit_max = F8::set1(exit_max);
   return p;
 }
 
@@ -153,10 +168,10 @@ inline Packet make_packet(const Slab::Precomputed* r, const Ray* rays, unsigned 
 // never fewer than the exact tests enter. A NaN anywhere keeps the child.
 inline unsigned frustum_children(const Packet& p, const WideNode<8>& node) {
   const float* planes = reinterpret_cast<const float*>(&node.bounds);
-  F entry = p.tnear_min, exit = p.exit_max;
+  F8 entry = p.tnear_min, exit = p.exit_max;
   for (int a = 0; a < 3; ++a) {
-    const F near_plane = F::load(planes + a * 8 + p.near_offset[a]);
-    const F far_plane = F::load(planes + a * 8 + (24 - p.near_offset[a]));
+    const F8 near_plane = F8::load(planes + a * 8 + p.near_offset[a]);
+    const F8 far_plane = F8::load(planes + a * 8 + (24 - p.near_offset[a]));
     // max/min keep their second operand (the bound so far) when the first is NaN.
     entry = max(min(near_plane * p.inv_lo[a], near_plane * p.inv_hi[a]) - p.fused_hi[a], entry);
     exit = min(max(far_plane * p.inv_lo[a], far_plane * p.inv_hi[a]) - p.fused_lo[a], exit);
@@ -178,50 +193,112 @@ RAYBENCH_INLINE unsigned child_hits(const Packet& p, const WideNode<8>& node, in
     t_entry = max(fmsub(near_plane, p.inv_dir[a], p.fused[a]), t_entry);
     t_exit = min(fmsub(far_plane, p.inv_dir[a], p.fused[a]), t_exit);
   }
-  const F hit = t_entry <= t_exit;
-  entry = t_entry | (hit ^ all_ones());
+  const auto hit = t_entry <= t_exit;
+  entry = select(hit, t_entry, nan_lanes());
   return hit.mask();
+}
+
+// Whether a leaf's triangles are tested for all rays at once (the
+// Möller-Trumbore packs) or ray by ray with the leaf's own test (the
+// watertight vertices).
+template <typename Leaf>
+inline constexpr bool kRayLanesLeaf =
+    Leaf::kLeaves == WideLeaves::kMollerTrumbore || Leaf::kLeaves == WideLeaves::kMollerTrumboreEdges;
+
+// The triangles of pack `t` against every ray at once: intersect_pack_simd
+// with the roles of the lanes swapped (a triangle broadcast, a ray per
+// lane), each step the same operation on the same operands, so each ray
+// gets the same t, u, v. Triangles in lane order, each replacing a ray's
+// hit when at or before it (tmax inclusive): the pack test's answer, the
+// closest lane and the last of equal ones. `node_tnear` is NaN in the
+// inactive lanes (they fail every comparison). Updates tmax, u, v and
+// `lane_of` (the pack lane) of the rays it hit; returns them.
+template <typename Pack>
+RAYBENCH_INLINE unsigned intersect_pack_rays(const Packet& p, F node_tnear, const Pack& t, F& tmax, F& u, F& v,
+                                             int* lane_of) {
+  const F zero = F::set1(0.0f);
+  const auto dot = [](const std::array<F, 3>& a, const std::array<F, 3>& b) {  // MollerTrumboreNormal::dot_fma
+    return fmadd(a[0], b[0], fmadd(a[1], b[1], a[2] * b[2]));
+  };
+  unsigned hit_rays = 0;
+  for (int j = 0; j < 8; ++j) {
+    const auto at = [&](const float (&x)[3][8]) { return std::array<F, 3>{F::set1(x[0][j]), F::set1(x[1][j]), F::set1(x[2][j])}; };
+    const std::array<F, 3> e1 = at(t.e1), e2 = at(t.e2);
+    const std::array<F, 3> normal = [&] {
+      if constexpr (StoresNormals<Pack>) {
+        return at(t.normal);
+      } else {
+        return std::array<F, 3>{fmsub(e1[1], e2[2], e1[2] * e2[1]), fmsub(e1[2], e2[0], e1[0] * e2[2]),
+                                fmsub(e1[0], e2[1], e1[1] * e2[0])};
+      }
+    }();
+    const std::array<F, 3>& d = p.dir;
+    const std::array<F, 3> c{F::set1(t.v0[0][j]) - p.org[0], F::set1(t.v0[1][j]) - p.org[1], F::set1(t.v0[2][j]) - p.org[2]};
+    const std::array<F, 3> r{fmsub(d[1], c[2], d[2] * c[1]), fmsub(d[2], c[0], d[0] * c[2]), fmsub(d[0], c[1], d[1] * c[0])};
+    const F det = dot(normal, d);
+    const F abs_det = det.abs(), det_sign = det.sign();
+    const F u_scaled = dot(r, e2) ^ det_sign;
+    const F v_scaled = dot(r, e1) ^ det_sign;
+    const F t_scaled = dot(normal, c) ^ det_sign;
+    const auto ok = (det != zero) & (u_scaled >= zero) & (v_scaled >= zero) & (u_scaled + v_scaled <= abs_det) &
+                    (t_scaled > abs_det * node_tnear);
+    if (!ok.mask()) continue;  // most triangles: no division
+    const F inv_det = F::set1(1.0f) / abs_det;
+    const F tt = t_scaled * inv_det;
+    const auto accept = ok & (tt > node_tnear) & (tt <= tmax);
+    unsigned rays = accept.mask();
+    if (!rays) continue;
+    tmax = select(accept, tt, tmax);
+    u = select(accept, u_scaled * inv_det, u);
+    v = select(accept, v_scaled * inv_det, v);
+    hit_rays |= rays;
+    for (; rays; rays &= rays - 1) lane_of[std::countr_zero(rays)] = j;
+  }
+  return hit_rays;
 }
 
 // The traversal stack: a subtree and each ray's entry distance into it (NaN
 // for the rays that do not enter it).
 struct PacketStack {
   static constexpr std::size_t kSize = 8 * wide_bvh_detail::kMaxDepth + 8;
-  alignas(32) float entry[kSize][kPacketRays];
+  alignas(64) float entry[kSize][kPacketRays];
   std::uint32_t ref[kSize];
   int top = 0;
 };
 
 }  // namespace wide_packet_detail
 
-// Traces the rays of `plan` among rays[0..7] as one packet; `r` are their
-// Slab precomputations. Closest hit: hits[i] for each ray i of the plan (the
-// pack slot as prim with PackSlots, as traverse_wide). Any hit: occluded[i].
+// Traces the rays of `plan` among rays[0..kPacketRays) as one packet; `r`
+// are their Slab precomputations. Closest hit: hits[i] for each ray i of
+// the plan (the pack slot as prim with PackSlots, as traverse_wide). Any
+// hit: occluded[i].
 template <bool AnyHit, typename Leaf, bool PackSlots>
 void trace_packet(const Bvh8& bvh, const Ray* rays, const Slab::Precomputed* r, PacketPlan plan, Hit* hits,
                   std::uint8_t* occluded) {
   using namespace wide_packet_detail;
   const Packet p = make_packet(r, rays, plan.lanes, bvh.bounds);
   typename Leaf::RayData leaf_ray[kPacketRays];
-  alignas(32) float tmax[kPacketRays];
+  alignas(64) float tmax[kPacketRays], outside[kPacketRays];
   Hit hit[kPacketRays];
   for (int i = 0; i < kPacketRays; ++i) {
-    tmax[i] = rays[i].tfar;
-    if (plan.lanes >> i & 1u) leaf_ray[i] = Leaf::precompute(rays[i]);
+    const bool in = plan.lanes >> i & 1u;
+    tmax[i] = in ? rays[i].tfar : 0.0f;
+    outside[i] = in ? 0.0f : std::numeric_limits<float>::quiet_NaN();
+    if (in) {
+      if constexpr (!kRayLanesLeaf<Leaf>) leaf_ray[i] = Leaf::precompute(rays[i]);
+    }
   }
   constexpr float kLargest = std::numeric_limits<float>::max();
-  const float kDone = -std::numeric_limits<float>::infinity();  // an occluded ray's tmax: it enters nothing more
+  // An occluded ray's tmax, so that it enters nothing more (any hit), and
+  // the occluded rays.
+  const float kDone = -std::numeric_limits<float>::infinity();
+  unsigned done = 0;
   F reach = F::load(tmax);  // SlabFma is not conservative: a subtree is skipped when farther than tmax
   F exit = min(reach, F::set1(kLargest));
   PacketStack stack;
   std::uint32_t ref = 0;
   unsigned active = plan.lanes;
-  F node_tnear;  // tnear in the lanes active at the node, NaN in the others
-  {
-    alignas(32) float outside[kPacketRays];
-    for (int i = 0; i < kPacketRays; ++i) outside[i] = plan.lanes >> i & 1u ? 0.0f : std::bit_cast<float>(0xffffffffu);
-    node_tnear = p.tnear | F::load(outside);
-  }
+  F node_tnear = p.tnear + F::load(outside);  // tnear in the lanes active at the node, NaN in the others
   const auto update_bounds = [&] {
     reach = F::load(tmax);
     exit = min(reach, F::set1(kLargest));
@@ -232,8 +309,8 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const Slab::Precomputed* r, 
       const int i = std::countr_zero(active);
       if constexpr (AnyHit) {
         if (traverse_wide_from<true, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, Hit{})) {
-          occluded[i] = 1;
           tmax[i] = kDone;
+          done |= 1u << i;
           update_bounds();
         }
       } else {
@@ -245,23 +322,51 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const Slab::Precomputed* r, 
       }
     } else if (ref & Bvh8::kLeafBit) {
       const std::uint32_t pack = ref & ~Bvh8::kLeafBit;
-      bool any = false;
-      for (unsigned lanes = active; lanes; lanes &= lanes - 1) {
-        const int i = std::countr_zero(lanes);
-        TriangleHit th{};
-        const int lane = Leaf::intersect(leaf_ray[i], tmax[i], bvh, pack, th);
-        if (lane < 0) continue;
-        any = true;
-        if constexpr (AnyHit) {
-          occluded[i] = 1;
-          tmax[i] = kDone;
-        } else {
-          tmax[i] = th.t;
-          if constexpr (PackSlots) hit[i] = {th.t, static_cast<std::int32_t>(Bvh8::slot(pack, lane)), th.u, th.v};
-          else hit[i] = {th.t, Leaf::prim(bvh, pack, lane), th.u, th.v};
+      if constexpr (kRayLanesLeaf<Leaf>) {
+        F best_t = reach, u = F::set1(0.0f), v = u;
+        alignas(64) int lane_of[kPacketRays];
+        unsigned hit_rays;
+        if constexpr (Leaf::kLeaves == WideLeaves::kMollerTrumbore)
+          hit_rays = intersect_pack_rays(p, node_tnear, bvh.packs[pack], best_t, u, v, lane_of);
+        else
+          hit_rays = intersect_pack_rays(p, node_tnear, bvh.edge_packs[pack], best_t, u, v, lane_of);
+        if (hit_rays) {
+          if constexpr (AnyHit) {
+            for (unsigned lanes = hit_rays; lanes; lanes &= lanes - 1) tmax[std::countr_zero(lanes)] = kDone;
+            done |= hit_rays;
+          } else {
+            alignas(64) float us[kPacketRays], vs[kPacketRays];
+            best_t.storeu(tmax);
+            u.storeu(us);
+            v.storeu(vs);
+            for (unsigned lanes = hit_rays; lanes; lanes &= lanes - 1) {
+              const int i = std::countr_zero(lanes);
+              const std::int32_t prim = PackSlots ? static_cast<std::int32_t>(Bvh8::slot(pack, lane_of[i]))
+                                                  : Leaf::prim(bvh, pack, lane_of[i]);
+              hit[i] = {tmax[i], prim, us[i], vs[i]};
+            }
+          }
+          update_bounds();
         }
+      } else {
+        bool any = false;
+        for (unsigned lanes = active; lanes; lanes &= lanes - 1) {
+          const int i = std::countr_zero(lanes);
+          TriangleHit th{};
+          const int lane = Leaf::intersect(leaf_ray[i], tmax[i], bvh, pack, th);
+          if (lane < 0) continue;
+          any = true;
+          if constexpr (AnyHit) {
+            tmax[i] = kDone;
+            done |= 1u << i;
+          } else {
+            tmax[i] = th.t;
+            if constexpr (PackSlots) hit[i] = {th.t, static_cast<std::int32_t>(Bvh8::slot(pack, lane)), th.u, th.v};
+            else hit[i] = {th.t, Leaf::prim(bvh, pack, lane), th.u, th.v};
+          }
+        }
+        if (any) update_bounds();
       }
-      if (any) update_bounds();
     } else {
       const WideNode<8>& node = bvh.nodes[ref];
       F child_entry[8];
@@ -289,20 +394,17 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const Slab::Precomputed* r, 
       if (stack.top == 0) {
         for (unsigned lanes = plan.lanes; lanes; lanes &= lanes - 1) {
           const int i = std::countr_zero(lanes);
-          if constexpr (AnyHit) {
-            if (tmax[i] != kDone) occluded[i] = 0;
-          } else {
-            hits[i] = hit[i];
-          }
+          if constexpr (AnyHit) occluded[i] = done >> i & 1u;
+          else hits[i] = hit[i];
         }
         return;
       }
       --stack.top;
-      const F within = F::load(stack.entry[stack.top]) <= reach;
+      const auto within = F::load(stack.entry[stack.top]) <= reach;
       active = within.mask();
       if (active) {
         ref = stack.ref[stack.top];
-        node_tnear = p.tnear | (within ^ all_ones());
+        node_tnear = select(within, p.tnear, nan_lanes());
         break;
       }
     }

@@ -12,7 +12,8 @@
 // With AVX-512F and VL (raybench::simd::kHaveAvx512; chosen at compile time,
 // -march=native on such a host) the same widths gain comparisons into a lane
 // mask (vcmpps k, chained under a mask for an and), for the leaf tests; they
-// answer bit for bit as compare-and-movemask. What AVX-512 paid and did not:
+// answer bit for bit as compare-and-movemask; FloatLanes<16> is AVX-512's
+// __m512, for the packet traversal. What AVX-512 paid and did not:
 // docs/notes/kernels-wide-traversal.md
 #pragma once
 
@@ -167,6 +168,50 @@ inline FloatLanes<4> min(FloatLanes<4> a, FloatLanes<4> b) { return {_mm_min_ps(
 inline FloatLanes<4> fmadd(FloatLanes<4> a, FloatLanes<4> b, FloatLanes<4> c) { return {_mm_fmadd_ps(a.v, b.v, c.v)}; }
 // a * b - c, rounded once (std::fma(a, b, -c)).
 inline FloatLanes<4> fmsub(FloatLanes<4> a, FloatLanes<4> b, FloatLanes<4> c) { return {_mm_fmsub_ps(a.v, b.v, c.v)}; }
+
+// Lane i of a where lane i of `m` is set (all ones), else of b.
+inline FloatLanes<8> select(FloatLanes<8> m, FloatLanes<8> a, FloatLanes<8> b) { return {_mm256_blendv_ps(b.v, a.v, m.v)}; }
+
+#if defined(RAYBENCH_AVX512)
+// 16 float lanes in one AVX-512 register, for the packet traversal's 16
+// rays (bvh/wide_bvh_packet.h). Comparisons give a LaneMask16 (a mask
+// register), with the same ordered, non-signalling predicates as above.
+struct LaneMask16 {
+  __mmask16 k;
+  unsigned mask() const { return k; }
+  LaneMask16 operator&(LaneMask16 o) const { return {static_cast<__mmask16>(k & o.k)}; }
+};
+
+template <>
+struct FloatLanes<16> {
+  __m512 v;
+  static FloatLanes set1(float x) { return {_mm512_set1_ps(x)}; }
+  static FloatLanes load(const float* p) { return {_mm512_load_ps(p)}; }
+  void storeu(float* p) const { _mm512_storeu_ps(p, v); }
+  FloatLanes operator+(FloatLanes o) const { return {_mm512_add_ps(v, o.v)}; }
+  FloatLanes operator-(FloatLanes o) const { return {_mm512_sub_ps(v, o.v)}; }
+  FloatLanes operator*(FloatLanes o) const { return {_mm512_mul_ps(v, o.v)}; }
+  FloatLanes operator/(FloatLanes o) const { return {_mm512_div_ps(v, o.v)}; }
+  // xor and and in their integer forms: AVX-512F alone (the float forms need DQ).
+  FloatLanes operator^(FloatLanes o) const {
+    return {_mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(v), _mm512_castps_si512(o.v)))};
+  }
+  LaneMask16 operator<=(FloatLanes o) const { return {_mm512_cmp_ps_mask(v, o.v, _CMP_LE_OQ)}; }
+  LaneMask16 operator<(FloatLanes o) const { return {_mm512_cmp_ps_mask(v, o.v, _CMP_LT_OQ)}; }
+  LaneMask16 operator>=(FloatLanes o) const { return {_mm512_cmp_ps_mask(v, o.v, _CMP_GE_OQ)}; }
+  LaneMask16 operator>(FloatLanes o) const { return {_mm512_cmp_ps_mask(v, o.v, _CMP_GT_OQ)}; }
+  LaneMask16 operator!=(FloatLanes o) const { return {_mm512_cmp_ps_mask(v, o.v, _CMP_NEQ_OQ)}; }
+  FloatLanes abs() const { return {_mm512_abs_ps(v)}; }
+  FloatLanes sign() const {
+    return {_mm512_castsi512_ps(_mm512_and_si512(_mm512_set1_epi32(INT32_MIN), _mm512_castps_si512(v)))};
+  }
+};
+inline FloatLanes<16> max(FloatLanes<16> a, FloatLanes<16> b) { return {_mm512_max_ps(a.v, b.v)}; }
+inline FloatLanes<16> min(FloatLanes<16> a, FloatLanes<16> b) { return {_mm512_min_ps(a.v, b.v)}; }
+inline FloatLanes<16> fmadd(FloatLanes<16> a, FloatLanes<16> b, FloatLanes<16> c) { return {_mm512_fmadd_ps(a.v, b.v, c.v)}; }
+inline FloatLanes<16> fmsub(FloatLanes<16> a, FloatLanes<16> b, FloatLanes<16> c) { return {_mm512_fmsub_ps(a.v, b.v, c.v)}; }
+inline FloatLanes<16> select(LaneMask16 m, FloatLanes<16> a, FloatLanes<16> b) { return {_mm512_mask_blend_ps(m.k, b.v, a.v)}; }
+#endif
 
 }  // namespace raybench::simd
 #endif
