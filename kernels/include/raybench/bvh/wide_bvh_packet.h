@@ -32,6 +32,7 @@
 #pragma once
 
 #include <array>
+#include <cstdlib>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -49,7 +50,8 @@ inline constexpr int kPacketRays = 16;
 inline constexpr int kPacketRays = 8;
 #endif
 inline constexpr int kMinPacketRays = 3;
-inline constexpr float kMinPacketCosine = 0.99f;         // directions within about 8 degrees of the first ray's
+inline constexpr int kAloneAtMost = 1;                  // active rays in a subtree that go on alone
+inline constexpr float kMinPacketCosine = 0.99f;        // directions within about 8 degrees of the first ray's
 inline constexpr float kMaxPacketOriginSpread = 0.02f;  // of the tree's bounds diagonal
 
 // The rays of a group traced as one packet (bit i: ray i of the group), and
@@ -58,43 +60,6 @@ struct PacketPlan {
   unsigned lanes = 0;
   int octant = 0;
 };
-
-// Which of the `n` (<= kPacketRays) rays go together, by the rule above;
-// `r` receives the Slab precomputation of the rays in the packet. Cheap
-// tests first (the direction's signs, then squared lengths, no division or
-// root), so that an incoherent group costs a few comparisons per ray.
-inline PacketPlan plan_packet(const Ray* rays, Slab::Precomputed* r, int n, float max_origin_distance) {
-  PacketPlan plan;
-  const auto signs = [](Vec3f d) {
-    return static_cast<int>(std::signbit(d.x)) | static_cast<int>(std::signbit(d.y)) << 1 |
-           static_cast<int>(std::signbit(d.z)) << 2;
-  };
-  constexpr float kMinCosine2 = kMinPacketCosine * kMinPacketCosine;
-  const float max_distance2 = max_origin_distance * max_origin_distance;
-  for (int lead = 0; lead + kMinPacketRays <= n; ++lead) {
-    r[lead] = Slab::precompute(rays[lead]);
-    if (!SlabFma::serves(r[lead])) continue;
-    const Vec3f lead_dir = rays[lead].dir, lead_org = rays[lead].org;
-    const float lead_len2 = dot(lead_dir, lead_dir);
-    const int octant = signs(lead_dir);
-    unsigned lanes = 1u << lead;
-    for (int i = lead + 1; i < n; ++i) {
-      const Vec3f d = rays[i].dir, o = rays[i].org - lead_org;
-      const float cosine = dot(d, lead_dir);
-      if (signs(d) != octant || !(cosine > 0.0f) || !(cosine * cosine >= kMinCosine2 * dot(d, d) * lead_len2) ||
-          !(dot(o, o) <= max_distance2))
-        continue;
-      r[i] = Slab::precompute(rays[i]);
-      if (SlabFma::serves(r[i])) lanes |= 1u << i;
-    }
-    if (std::popcount(lanes) >= kMinPacketRays) {
-      plan.lanes = lanes;
-      plan.octant = ray_octant(r[lead]);
-    }
-    return plan;  // the first served ray leads, or no packet
-  }
-  return plan;
-}
 
 #if defined(__AVX2__)
 namespace wide_packet_detail {
@@ -105,11 +70,12 @@ using F8 = simd::FloatLanes<8>;           // a node's 8 children
 inline F nan_lanes() { return F::set1(std::numeric_limits<float>::quiet_NaN()); }
 
 // The packet's rays lane by lane as the single-ray tests read each (the box
-// test: 1/d and the fused offset o/d of RayLanes<8>::from<SlabFma>; the
-// triangle test: origin, direction, tnear), and the frustum: per axis the
-// bounds of 1/d and of o/d over the packet, widened by a padding that
-// covers the rounding of both the per-ray distances and the interval's own
-// (16 times the worst case: 3 half-ulps of the largest term).
+// test: 1/d and the fused offset o/d of RayLanes<8>::from<SlabFma>, each
+// the same single rounding; the triangle test: origin, direction, tnear),
+// and the frustum: per axis the bounds of 1/d and of o/d over the packet,
+// widened by a padding that covers the rounding of both the per-ray
+// distances and the interval's own (16 times the worst case: 3 half-ulps of
+// the largest term). Lanes outside the plan hold their own ray or NaN.
 struct Packet {
   std::array<F, 3> org, dir;
   F inv_dir[3], fused[3], tnear;
@@ -118,50 +84,79 @@ struct Packet {
   F8 tnear_min, exit_max;
 };
 
-inline Packet make_packet(const Slab::Precomputed* r, const Ray* rays, unsigned lanes, const BBox& extent) {
-  Packet p;
-  alignas(64) float org[3][kPacketRays], dir[3][kPacketRays], inv[3][kPacketRays], fused[3][kPacketRays],
-      tnear[kPacketRays];
-  const int lead = std::countr_zero(lanes);
-  const auto ray_of = [&](int i) { return lanes >> i & 1u ? i : lead; };  // lanes outside the packet repeat its first ray
-  float tnear_min = std::numeric_limits<float>::infinity(), exit_max = -std::numeric_limits<float>::infinity();
+// Groups rays[0..n) (n <= kPacketRays) by the rule of the file's header,
+// all lanes at once, and sets up `p` for the packet. The first ray with a
+// finite origin and direction and no zero direction component leads.
+inline PacketPlan plan_packet(const Ray* rays, int n, float max_origin_distance, const BBox& extent, Packet& p) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  if (n < kMinPacketRays) return {};
+  // First a glance at two rays against the first, in scalar code: a group
+  // where neither goes with it is incoherent (diffuse, uniform rays), and
+  // costs no more than this.
+  const auto together = [&](const Ray& a, const Ray& b) {
+    const float cosine = dot(a.dir, b.dir);
+    const Vec3f offset = a.org - b.org;
+    return a.dir.x * b.dir.x > 0.0f && a.dir.y * b.dir.y > 0.0f && a.dir.z * b.dir.z > 0.0f && cosine > 0.0f &&
+           cosine * cosine >= kMinPacketCosine * kMinPacketCosine * dot(a.dir, a.dir) * dot(b.dir, b.dir) &&
+           dot(offset, offset) <= max_origin_distance * max_origin_distance;
+  };
+  if (!together(rays[0], rays[n / 2]) && !together(rays[0], rays[n - 1])) return {};
+  alignas(64) float soa[8][kPacketRays];  // ox oy oz tnear dx dy dz tfar, as a Ray's 8 floats
+  for (int i = 0; i < kPacketRays; ++i) {
+    const float* ray = reinterpret_cast<const float*>(i < n ? &rays[i] : nullptr);
+    for (int k = 0; k < 8; ++k) soa[k][i] = i < n ? ray[k] : std::numeric_limits<float>::quiet_NaN();
+  }
+  const F inf = F::set1(kInf);
+  auto usable = F::set1(0.0f) <= F::set1(0.0f);  // every lane
   for (int a = 0; a < 3; ++a) {
-    float inv_lo = std::numeric_limits<float>::infinity(), inv_hi = -inv_lo, fused_lo = inv_lo, fused_hi = -inv_lo,
-          fused_abs = 0.0f;
-    for (int i = 0; i < kPacketRays; ++i) {
-      const int k = ray_of(i);
-      org[a][i] = rays[k].org[a];
-      dir[a][i] = rays[k].dir[a];
-      inv[a][i] = r[k].inv_dir[a];
-      fused[a][i] = r[k].org[a] * r[k].inv_dir[a];  // as RayLanes::from rounds it
-      inv_lo = std::min(inv_lo, inv[a][i]);
-      inv_hi = std::max(inv_hi, inv[a][i]);
-      fused_lo = std::min(fused_lo, fused[a][i]);
-      fused_hi = std::max(fused_hi, fused[a][i]);
-      fused_abs = std::max(fused_abs, std::fabs(fused[a][i]));
-    }
+    p.org[a] = F::load(soa[a]);
+    p.dir[a] = F::load(soa[4 + a]);
+    p.inv_dir[a] = F::set1(1.0f) / p.dir[a];  // Slab::precompute's 1/d, rounded alike
+    p.fused[a] = p.org[a] * p.inv_dir[a];
+    usable = usable & (p.org[a].abs() < inf) & (p.dir[a].abs() < inf) & (p.inv_dir[a].abs() < inf);
+  }
+  p.tnear = F::load(soa[3]);
+  const unsigned usable_rays = usable.mask();
+  if (usable_rays == 0) return {};
+  const int lead = std::countr_zero(usable_rays);
+  if (lead + kMinPacketRays > n) return {};
+  std::array<F, 3> lead_org, lead_dir;
+  for (int a = 0; a < 3; ++a) {
+    lead_org[a] = F::set1(soa[a][lead]);
+    lead_dir[a] = F::set1(soa[4 + a][lead]);
+  }
+  const auto dot = [](const std::array<F, 3>& x, const std::array<F, 3>& y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
+  const F cosine = dot(p.dir, lead_dir);
+  const std::array<F, 3> offset{p.org[0] - lead_org[0], p.org[1] - lead_org[1], p.org[2] - lead_org[2]};
+  const F zero = F::set1(0.0f);
+  // Same octant: every component's sign the lead's (none is zero: 1/d is finite).
+  const auto in = usable & (p.dir[0] * lead_dir[0] > zero) & (p.dir[1] * lead_dir[1] > zero) &
+                  (p.dir[2] * lead_dir[2] > zero) & (cosine > zero) &
+                  (cosine * cosine >= F::set1(kMinPacketCosine * kMinPacketCosine) * dot(p.dir, p.dir) * dot(lead_dir, lead_dir)) &
+                  (dot(offset, offset) <= F::set1(max_origin_distance * max_origin_distance));
+  PacketPlan plan;
+  plan.lanes = in.mask();
+  if (std::popcount(plan.lanes) < kMinPacketRays) return {};
+  for (int a = 0; a < 3; ++a) {
+    const bool negative = std::signbit(soa[4 + a][lead]);
+    plan.octant |= static_cast<int>(negative) << a;
+    p.near_offset[a] = negative ? 3 * 8 : 0;
+    const float inv_lo = simd::reduce_min(select(in, p.inv_dir[a], inf));
+    const float inv_hi = simd::reduce_max(select(in, p.inv_dir[a], F::set1(-kInf)));
+    const float fused_lo = simd::reduce_min(select(in, p.fused[a], inf));
+    const float fused_hi = simd::reduce_max(select(in, p.fused[a], F::set1(-kInf)));
+    const float fused_abs = simd::reduce_max(select(in, p.fused[a].abs(), zero));
     const float plane_abs = std::max(std::fabs(extent.lower[a]), std::fabs(extent.upper[a]));
     const float pad = 0x1p-20f * (plane_abs * std::max(std::fabs(inv_lo), std::fabs(inv_hi)) + fused_abs);
-    p.org[a] = F::load(org[a]);
-    p.dir[a] = F::load(dir[a]);
-    p.inv_dir[a] = F::load(inv[a]);
-    p.fused[a] = F::load(fused[a]);
     p.inv_lo[a] = F8::set1(inv_lo);
     p.inv_hi[a] = F8::set1(inv_hi);
     p.fused_hi[a] = F8::set1(fused_hi + pad);
     p.fused_lo[a] = F8::set1(fused_lo - pad);
-    p.near_offset[a] = r[lead].negative[a] ? 3 * 8 : 0;
   }
-  for (int i = 0; i < kPacketRays; ++i) {
-    const int k = ray_of(i);
-    tnear[i] = rays[k].tnear;  // = r[k].tnear: the packet's rays are finite
-    tnear_min = std::min(tnear_min, tnear[i]);
-    exit_max = std::max(exit_max, box_exit_bound<SlabFma>(rays[k].tfar));
-  }
-  p.tnear = F::load(tnear);
-  p.tnear_min = F8::set1(tnear_min);
-  p.exit_max = F8::set1(exit_max);
-  return p;
+  p.tnear_min = F8::set1(simd::reduce_min(select(in, p.tnear, inf)));
+  const F exit_bound = min(F::load(soa[7]), F::set1(std::numeric_limits<float>::max()));  // box_exit_bound<SlabFma>
+  p.exit_max = F8::set1(simd::reduce_max(select(in, exit_bound, F::set1(-kInf))));
+  return plan;
 }
 
 // The children of `node` some ray of the packet may enter (bit i: lane i);
@@ -268,15 +263,14 @@ struct PacketStack {
 
 }  // namespace wide_packet_detail
 
-// Traces the rays of `plan` among rays[0..kPacketRays) as one packet; `r`
-// are their Slab precomputations. Closest hit: hits[i] for each ray i of
+// Traces the rays of `plan` among rays[0..kPacketRays) as one packet, set
+// up in `p` by plan_packet. Closest hit: hits[i] for each ray i of
 // the plan (the pack slot as prim with PackSlots, as traverse_wide). Any
 // hit: occluded[i].
 template <bool AnyHit, typename Leaf, bool PackSlots>
-void trace_packet(const Bvh8& bvh, const Ray* rays, const Slab::Precomputed* r, PacketPlan plan, Hit* hits,
+void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Packet& p, PacketPlan plan, Hit* hits,
                   std::uint8_t* occluded) {
   using namespace wide_packet_detail;
-  const Packet p = make_packet(r, rays, plan.lanes, bvh.bounds);
   typename Leaf::RayData leaf_ray[kPacketRays];
   alignas(64) float tmax[kPacketRays], outside[kPacketRays];
   Hit hit[kPacketRays];
@@ -304,22 +298,21 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const Slab::Precomputed* r, 
     exit = min(reach, F::set1(kLargest));
   };
   for (;;) {
-    if (std::popcount(active) == 1) {
-      // One ray left in this subtree: it goes on alone from here.
-      const int i = std::countr_zero(active);
-      if constexpr (AnyHit) {
-        if (traverse_wide_from<true, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, Hit{})) {
-          tmax[i] = kDone;
-          done |= 1u << i;
-          update_bounds();
-        }
-      } else {
-        hit[i] = traverse_wide_from<false, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, hit[i]);
-        if (hit[i].hit()) {
-          tmax[i] = hit[i].t;
-          update_bounds();
+    if (std::popcount(active) <= kAloneAtMost) {
+      // Few rays left in this subtree: each goes on alone from here.
+      for (unsigned lanes = active; lanes; lanes &= lanes - 1) {
+        const int i = std::countr_zero(lanes);
+        if constexpr (AnyHit) {
+          if (traverse_wide_from<true, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, Hit{})) {
+            tmax[i] = kDone;
+            done |= 1u << i;
+          }
+        } else {
+          hit[i] = traverse_wide_from<false, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, hit[i]);
+          if (hit[i].hit()) tmax[i] = hit[i].t;
         }
       }
+      update_bounds();
     } else if (ref & Bvh8::kLeafBit) {
       const std::uint32_t pack = ref & ~Bvh8::kLeafBit;
       if constexpr (kRayLanesLeaf<Leaf>) {
@@ -412,6 +405,19 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const Slab::Precomputed* r, 
 }
 #endif
 
+// The rays of rays[0..n) (n <= kPacketRays) that `intersect_packet_batch`
+// traces as one packet over a tree whose bounds are `extent` (bit i: ray
+// i); 0 where the traversal has no SIMD packets (without AVX2).
+inline unsigned packet_lanes(const Ray* rays, int n, const BBox& extent) {
+#if defined(__AVX2__)
+  wide_packet_detail::Packet p;
+  return plan_packet(rays, n, kMaxPacketOriginSpread * length(extent.extent()), extent, p).lanes;
+#else
+  (void)rays, (void)n, (void)extent;
+  return 0;
+#endif
+}
+
 // Closest hit of every ray, consecutive coherent rays traced as packets
 // (plan_packet), the others alone: the same Hit for every ray as
 // intersect_wide_batch. Screened rays, as wide_bvh_batch.h's loops.
@@ -422,11 +428,11 @@ inline void intersect_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, s
   const float max_origin_distance = bvh.nodes.empty() ? 0.0f : kMaxPacketOriginSpread * length(bvh.bounds.extent());
   for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
     const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
-    Slab::Precomputed r[kPacketRays];
-    const PacketPlan plan = bvh.nodes.empty() ? PacketPlan{} : plan_packet(&rays[first], r, n, max_origin_distance);
+    wide_packet_detail::Packet p;
+    const PacketPlan plan = bvh.nodes.empty() ? PacketPlan{} : plan_packet(&rays[first], n, max_origin_distance, bvh.bounds, p);
     for (int i = 0; i < n; ++i)
       if (!(plan.lanes >> i & 1u)) hits[first + i] = traverse_wide<false, Leaf, SlabFma, kSlots>(bvh, rays[first + i]);
-    if (plan.lanes) trace_packet<false, Leaf, kSlots>(bvh, &rays[first], r, plan, &hits[first], nullptr);
+    if (plan.lanes) trace_packet<false, Leaf, kSlots>(bvh, &rays[first], p, plan, &hits[first], nullptr);
   }
 #else
   for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = traverse_wide<false, Leaf, SlabFma, kSlots>(bvh, rays[i]);
@@ -443,11 +449,11 @@ inline void occluded_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, st
   const float max_origin_distance = bvh.nodes.empty() ? 0.0f : kMaxPacketOriginSpread * length(bvh.bounds.extent());
   for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
     const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
-    Slab::Precomputed r[kPacketRays];
-    const PacketPlan plan = bvh.nodes.empty() ? PacketPlan{} : plan_packet(&rays[first], r, n, max_origin_distance);
+    wide_packet_detail::Packet p;
+    const PacketPlan plan = bvh.nodes.empty() ? PacketPlan{} : plan_packet(&rays[first], n, max_origin_distance, bvh.bounds, p);
     for (int i = 0; i < n; ++i)
       if (!(plan.lanes >> i & 1u)) occluded[first + i] = occluded_wide<Leaf, SlabFma>(bvh, rays[first + i]);
-    if (plan.lanes) trace_packet<true, Leaf, false>(bvh, &rays[first], r, plan, nullptr, &occluded[first]);
+    if (plan.lanes) trace_packet<true, Leaf, false>(bvh, &rays[first], p, plan, nullptr, &occluded[first]);
   }
 #else
   for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = occluded_wide<Leaf, SlabFma>(bvh, rays[i]);

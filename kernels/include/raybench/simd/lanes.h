@@ -171,6 +171,17 @@ inline FloatLanes<4> fmsub(FloatLanes<4> a, FloatLanes<4> b, FloatLanes<4> c) { 
 
 // Lane i of a where lane i of `m` is set (all ones), else of b.
 inline FloatLanes<8> select(FloatLanes<8> m, FloatLanes<8> a, FloatLanes<8> b) { return {_mm256_blendv_ps(b.v, a.v, m.v)}; }
+// The smallest and the largest lane (lanes without NaN).
+inline float reduce_min(FloatLanes<8> x) {
+  __m128 a = _mm_min_ps(_mm256_castps256_ps128(x.v), _mm256_extractf128_ps(x.v, 1));
+  a = _mm_min_ps(a, _mm_movehl_ps(a, a));
+  return _mm_cvtss_f32(_mm_min_ss(a, _mm_movehdup_ps(a)));
+}
+inline float reduce_max(FloatLanes<8> x) {
+  __m128 a = _mm_max_ps(_mm256_castps256_ps128(x.v), _mm256_extractf128_ps(x.v, 1));
+  a = _mm_max_ps(a, _mm_movehl_ps(a, a));
+  return _mm_cvtss_f32(_mm_max_ss(a, _mm_movehdup_ps(a)));
+}
 
 #if defined(RAYBENCH_AVX512)
 // 16 float lanes in one AVX-512 register, for the packet traversal's 16
@@ -211,6 +222,8 @@ inline FloatLanes<16> min(FloatLanes<16> a, FloatLanes<16> b) { return {_mm512_m
 inline FloatLanes<16> fmadd(FloatLanes<16> a, FloatLanes<16> b, FloatLanes<16> c) { return {_mm512_fmadd_ps(a.v, b.v, c.v)}; }
 inline FloatLanes<16> fmsub(FloatLanes<16> a, FloatLanes<16> b, FloatLanes<16> c) { return {_mm512_fmsub_ps(a.v, b.v, c.v)}; }
 inline FloatLanes<16> select(LaneMask16 m, FloatLanes<16> a, FloatLanes<16> b) { return {_mm512_mask_blend_ps(m.k, b.v, a.v)}; }
+inline float reduce_min(FloatLanes<16> x) { return _mm512_reduce_min_ps(x.v); }
+inline float reduce_max(FloatLanes<16> x) { return _mm512_reduce_max_ps(x.v); }
 #endif
 
 }  // namespace raybench::simd
