@@ -215,7 +215,14 @@ RAYBENCH_INLINE unsigned intersect_pack_rays(const Packet& p, F node_tnear, cons
   const auto dot = [](const std::array<F, 3>& a, const std::array<F, 3>& b) {  // MollerTrumboreNormal::dot_fma
     return fmadd(a[0], b[0], fmadd(a[1], b[1], a[2] * b[2]));
   };
-  unsigned hit_rays = 0;
+  using M = decltype(zero <= zero);  // a lane mask: FloatLanes<8> (AVX2) or LaneMask16
+  // First every triangle's tests but the distance's bound (no branch: which
+  // triangles pass for which rays is data, not control flow), then, in lane
+  // order, only those that some ray passed.
+  alignas(64) float t_scaled_of[8][kPacketRays], abs_det_of[8][kPacketRays], u_scaled_of[8][kPacketRays],
+      v_scaled_of[8][kPacketRays];
+  M ok_of[8];
+  unsigned candidates = 0;
   for (int j = 0; j < 8; ++j) {
     const auto at = [&](const float (&x)[3][8]) { return std::array<F, 3>{F::set1(x[0][j]), F::set1(x[1][j]), F::set1(x[2][j])}; };
     const std::array<F, 3> e1 = at(t.e1), e2 = at(t.e2);
@@ -235,17 +242,25 @@ RAYBENCH_INLINE unsigned intersect_pack_rays(const Packet& p, F node_tnear, cons
     const F u_scaled = dot(r, e2) ^ det_sign;
     const F v_scaled = dot(r, e1) ^ det_sign;
     const F t_scaled = dot(normal, c) ^ det_sign;
-    const auto ok = (det != zero) & (u_scaled >= zero) & (v_scaled >= zero) & (u_scaled + v_scaled <= abs_det) &
-                    (t_scaled > abs_det * node_tnear);
-    if (!ok.mask()) continue;  // most triangles: no division
-    const F inv_det = F::set1(1.0f) / abs_det;
-    const F tt = t_scaled * inv_det;
-    const auto accept = ok & (tt > node_tnear) & (tt <= tmax);
+    ok_of[j] = (det != zero) & (u_scaled >= zero) & (v_scaled >= zero) & (u_scaled + v_scaled <= abs_det) &
+               (t_scaled > abs_det * node_tnear);
+    candidates |= static_cast<unsigned>(ok_of[j].mask() != 0) << j;
+    t_scaled.storeu(t_scaled_of[j]);
+    abs_det.storeu(abs_det_of[j]);
+    u_scaled.storeu(u_scaled_of[j]);
+    v_scaled.storeu(v_scaled_of[j]);
+  }
+  unsigned hit_rays = 0;
+  for (; candidates; candidates &= candidates - 1) {
+    const int j = std::countr_zero(candidates);
+    const F inv_det = F::set1(1.0f) / F::load(abs_det_of[j]);
+    const F tt = F::load(t_scaled_of[j]) * inv_det;
+    const auto accept = ok_of[j] & (tt > node_tnear) & (tt <= tmax);
     unsigned rays = accept.mask();
     if (!rays) continue;
     tmax = select(accept, tt, tmax);
-    u = select(accept, u_scaled * inv_det, u);
-    v = select(accept, v_scaled * inv_det, v);
+    u = select(accept, F::load(u_scaled_of[j]) * inv_det, u);
+    v = select(accept, F::load(v_scaled_of[j]) * inv_det, v);
     hit_rays |= rays;
     for (; rays; rays &= rays - 1) lane_of[std::countr_zero(rays)] = j;
   }
