@@ -41,8 +41,8 @@
 namespace raybench {
 namespace {
 
-// Packet: intersect and occluded trace coherent rays in packets (8 wide,
-// SlabFma only).
+// Packet: intersect and occluded trace coherent rays in packets (kPacketRays
+// wide, SlabFma only).
 template <int W, typename Leaf, typename BoxTest, bool Packet = false>
 class WideBvhBackend final : public Backend {
  public:
@@ -149,9 +149,10 @@ std::vector<BackendInfo> wide_backend_names() {
   }
   if constexpr (W == 8) {
     out.push_back({"bvh8:packet",
-                   "bvh8 tracing coherent consecutive rays in packets of 8 (a frustum test per node, per-ray masks, "
-                   "single rays where rays diverge), the same answers as bvh8 bit for bit; triangle scenes only; "
-                   "any bvh8 name with the plain box test takes :packet"});
+                   fmt::format("bvh8 tracing coherent consecutive rays in packets of {} ({}: a frustum test per node, "
+                               "per-ray masks, single rays where rays diverge), the same answers as bvh8 bit for bit; "
+                               "triangle scenes only; any bvh8 name with the plain box test takes :packet",
+                               kPacketRays, !kHaveAvx2 ? "without AVX2 every ray alone" : kPacketRays == 16 ? "AVX-512" : "AVX2")});
   }
   out.push_back({family + ":robust", fmt::format("{} with the conservative {}-wide box test (slab_robust_ray); any {} "
                                                  "name takes :robust or :plain_boxes (slab_fma, the default) for its box test",
