@@ -1,38 +1,36 @@
-// Packets of up to 8 coherent rays traced together through a Bvh8, closest
-// hit and any hit, with exactly the answers of the single-ray traversal
-// (wide_bvh_traverse.h): the `bvh8:packet` backends.
+// Packets of coherent rays (16 with AVX-512, 8 with AVX2) traced together
+// through a Bvh8, closest hit and any hit, with exactly the answers of the
+// single-ray traversal (wide_bvh_traverse.h): the `bvh8:packet` backends.
 // Algorithm: a packet visits a node once for all its rays (Wald, Slusallek,
 // Benthin & Wagner, "Interactive Rendering with Coherent Ray Tracing", EG
-// 2001). A conservative frustum test first picks the children any ray of
-// the packet may enter, with one 8-wide test: interval bounds over the
-// packet's reciprocal directions and origins, padded beyond every rounding
-// error (the packet frustum of Wald, Boulos & Shirley, "Ray Tracing Deformable
-// Scenes Using Dynamic Bounding Volume Hierarchies", TOG 2007; Embree's
-// node_intersector_frustum.h). Each picked child is then tested against
-// every ray at once with the single-ray box test's own operations in the
-// same order, so each ray's lane is active in exactly the subtrees its own
+// 2001). A conservative frustum test picks the children any ray may enter,
+// with one 8-wide test of interval bounds over the packet's 1/d and o/d,
+// padded beyond every rounding error (Wald, Boulos & Shirley, TOG 2007;
+// Embree's node_intersector_frustum.h). Each picked child is then tested
+// against every ray at once with the single-ray box test's own operations
+// in the same order, so a ray is active in exactly the subtrees its own
 // traversal enters. Children are visited in the node's far-to-near order
-// for the packet's octant (closest hit) or in lane order (any hit), the
-// orders each ray uses alone, and a popped subtree is skipped for a ray when
-// it is farther than that ray's closest hit: every ray meets its leaves in
-// its own order and keeps the same ties. Leaves are tested ray by ray with
-// the single-ray leaf test. A subtree left with one active ray is traced
-// for it alone (traverse_wide_from), as Embree's hybrid traversal turns to
+// for the packet's octant (closest hit) or in lane order (any hit), as each
+// ray alone; a popped subtree is skipped for a ray farther than its hit.
+// So every ray meets its leaves in its own order and keeps its ties.
+// Möller-Trumbore leaves test each triangle against every ray at once
+// (the pack test with the lanes' roles swapped, same operations); other
+// leaves ray by ray. A subtree left with kAloneAtMost active rays is traced
+// by each alone (traverse_wide_from), as Embree's hybrid traversal turns to
 // single rays (bvh_intersector_hybrid.cpp).
-// Grouping: each run of up to 8 consecutive rays is a packet of those that
-// share the first served ray's octant, take the fused box test (no zero
-// direction component: SlabFma::serves), point within kMinPacketCosine of
-// its direction and start within kMaxPacketOriginSpread of its origin; the
-// others, and a group with fewer than kMinPacketRays such rays, are traced
-// alone. Incoherent ray sets (diffuse, uniform) so run the single-ray
-// traversal, at the cost of the check.
-// Guarantee: every ray's answer is traverse_wide's for the same ray, the Hit
-// bit for bit and the occlusion bit, whatever the grouping (tested:
-// kernels/tests/wide_bvh_packet_test.cpp). The box test is SlabFma's.
+// Grouping: consecutive rays form a packet of those that share the first
+// usable ray's octant (finite, no zero direction component: SlabFma's
+// rays), point within kMinPacketCosine of its direction and start within
+// kMaxPacketOriginSpread of its origin; the others, and a group with fewer
+// than kMinPacketRays such rays, are traced alone. A scalar glance at two
+// rays turns incoherent groups (diffuse, uniform rays) away first.
+// Guarantee: every ray's answer is traverse_wide's with SlabFma, the Hit bit
+// for bit and the occlusion bit, whatever the grouping (tested:
+// kernels/tests/wide_bvh_packet_test.cpp). Design and measurements:
+// docs/notes/kernels-packets.md
 #pragma once
 
 #include <array>
-#include <cstdlib>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -50,7 +48,10 @@ inline constexpr int kPacketRays = 16;
 inline constexpr int kPacketRays = 8;
 #endif
 inline constexpr int kMinPacketRays = 3;
-inline constexpr int kAloneAtMost = 1;                  // active rays in a subtree that go on alone
+// Active rays in a subtree that go on alone: 3 of 16 (measured: 1 of 16 was
+// 8-15 % slower on the terrain's tiled rays, the same on Sponza's), the same
+// share of 8.
+inline constexpr int kAloneAtMost = kPacketRays == 16 ? 3 : 1;
 inline constexpr float kMinPacketCosine = 0.99f;        // directions within about 8 degrees of the first ray's
 inline constexpr float kMaxPacketOriginSpread = 0.02f;  // of the tree's bounds diagonal
 
