@@ -23,7 +23,9 @@
 // rays), point within kMinPacketCosine of its direction and start within
 // kMaxPacketOriginSpread of its origin; the others, and a group with fewer
 // than kMinPacketRays such rays, are traced alone. A scalar glance at two
-// rays turns incoherent groups (diffuse, uniform rays) away first.
+// rays turns incoherent groups away first, and a batch whose first groups
+// all look incoherent (diffuse, uniform rays) is traced by the single-ray
+// batch loop itself (wide_bvh_batch.h).
 // Guarantee: every ray's answer is traverse_wide's with SlabFma, the Hit bit
 // for bit and the occlusion bit, whatever the grouping (tested:
 // kernels/tests/wide_bvh_packet_test.cpp). Design and measurements:
@@ -37,6 +39,7 @@
 #include <limits>
 #include <span>
 
+#include "raybench/bvh/wide_bvh_batch.h"
 #include "raybench/bvh/wide_bvh_traverse.h"
 
 namespace raybench {
@@ -89,15 +92,11 @@ struct Packet {
   F8 tnear_min, exit_max;
 };
 
-// Groups rays[0..n) (n <= kPacketRays) by the rule of the file's header,
-// all lanes at once, and sets up `p` for the packet. The first ray with a
-// finite origin and direction and no zero direction component leads.
-inline PacketPlan plan_packet(const Ray* rays, int n, float max_origin_distance, const BBox& extent, Packet& p) {
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  if (n < kMinPacketRays) return {};
-  // First a glance at two rays against the first, in scalar code: a group
-  // where neither goes with it is incoherent (diffuse, uniform rays), and
-  // costs no more than this.
+// A glance at a group of rays[0..n) (n <= kPacketRays), in scalar code: the
+// middle and the last ray go with the first (same octant, within the
+// cosine and the origin distance). A group where either does not is taken
+// for incoherent (diffuse, uniform rays) and costs no more than this.
+inline bool looks_coherent(const Ray* rays, int n, float max_origin_distance) {
   const auto together = [&](const Ray& a, const Ray& b) {
     const float cosine = dot(a.dir, b.dir);
     const Vec3f offset = a.org - b.org;
@@ -105,7 +104,29 @@ inline PacketPlan plan_packet(const Ray* rays, int n, float max_origin_distance,
            cosine * cosine >= kMinPacketCosine * kMinPacketCosine * dot(a.dir, a.dir) * dot(b.dir, b.dir) &&
            dot(offset, offset) <= max_origin_distance * max_origin_distance;
   };
-  if (!together(rays[0], rays[n / 2]) || !together(rays[0], rays[n - 1])) return {};
+  return n >= kMinPacketRays && together(rays[0], rays[n / 2]) && together(rays[0], rays[n - 1]);
+}
+
+// Whether a batch is worth planning packets for: some of its first
+// kSampledGroups groups look coherent. A batch of incoherent rays is then
+// traced exactly as the single-ray batch traces it, the same code, at the
+// cost of a few glances.
+inline constexpr int kSampledGroups = 4;
+inline bool batch_looks_coherent(std::span<const Ray> rays, float max_origin_distance) {
+  for (std::size_t g = 0; g < kSampledGroups && g * kPacketRays < rays.size(); ++g) {
+    const std::size_t first = g * kPacketRays;
+    const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
+    if (looks_coherent(&rays[first], n, max_origin_distance)) return true;
+  }
+  return false;
+}
+
+// Groups rays[0..n) (n <= kPacketRays) by the rule of the file's header,
+// all lanes at once, and sets up `p` for the packet. The first ray with a
+// finite origin and direction and no zero direction component leads.
+inline PacketPlan plan_packet(const Ray* rays, int n, float max_origin_distance, const BBox& extent, Packet& p) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  if (!looks_coherent(rays, n, max_origin_distance)) return {};
   alignas(64) float soa[8][kPacketRays];  // ox oy oz tnear dx dy dz tfar, as a Ray's 8 floats
   for (int i = 0; i < kPacketRays; ++i) {
     const float* ray = reinterpret_cast<const float*>(i < n ? &rays[i] : nullptr);
@@ -439,17 +460,20 @@ inline unsigned packet_lanes(const Ray* rays, int n, const BBox& extent) {
 }
 
 // Closest hit of every ray, consecutive coherent rays traced as packets
-// (plan_packet), the others alone: the same Hit for every ray as
+// (plan_packet), the others alone, and a batch whose first groups all look
+// incoherent by intersect_wide_batch itself: the same Hit for every ray as
 // intersect_wide_batch. Screened rays, as wide_bvh_batch.h's loops.
 template <typename Leaf>
 inline void intersect_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, std::span<Hit> hits) {
   constexpr bool kSlots = !Leaf::kPrimsInPack;
 #if defined(__AVX2__)
   const float max_origin_distance = bvh.nodes.empty() ? 0.0f : kMaxPacketOriginSpread * length(bvh.bounds.extent());
+  if (bvh.nodes.empty() || !wide_packet_detail::batch_looks_coherent(rays, max_origin_distance))
+    return intersect_wide_batch<Leaf, SlabFma>(bvh, rays, hits);
   for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
     const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
     wide_packet_detail::Packet p;
-    const PacketPlan plan = bvh.nodes.empty() ? PacketPlan{} : plan_packet(&rays[first], n, max_origin_distance, bvh.bounds, p);
+    const PacketPlan plan = plan_packet(&rays[first], n, max_origin_distance, bvh.bounds, p);
     for (int i = 0; i < n; ++i)
       if (!(plan.lanes >> i & 1u)) hits[first + i] = traverse_wide<false, Leaf, SlabFma, kSlots>(bvh, rays[first + i]);
     if (plan.lanes) trace_packet<false, Leaf, kSlots>(bvh, &rays[first], p, plan, &hits[first], nullptr);
@@ -467,10 +491,12 @@ template <typename Leaf>
 inline void occluded_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, std::span<std::uint8_t> occluded) {
 #if defined(__AVX2__)
   const float max_origin_distance = bvh.nodes.empty() ? 0.0f : kMaxPacketOriginSpread * length(bvh.bounds.extent());
+  if (bvh.nodes.empty() || !wide_packet_detail::batch_looks_coherent(rays, max_origin_distance))
+    return occluded_wide_batch<Leaf, SlabFma>(bvh, rays, occluded);
   for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
     const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
     wide_packet_detail::Packet p;
-    const PacketPlan plan = bvh.nodes.empty() ? PacketPlan{} : plan_packet(&rays[first], n, max_origin_distance, bvh.bounds, p);
+    const PacketPlan plan = plan_packet(&rays[first], n, max_origin_distance, bvh.bounds, p);
     for (int i = 0; i < n; ++i)
       if (!(plan.lanes >> i & 1u)) occluded[first + i] = occluded_wide<Leaf, SlabFma>(bvh, rays[first + i]);
     if (plan.lanes) trace_packet<true, Leaf, false>(bvh, &rays[first], p, plan, nullptr, &occluded[first]);
