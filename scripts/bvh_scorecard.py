@@ -1,13 +1,14 @@
 """The scorecard of our BVHs against Embree, per scene and per machine class, from one results CSV.
 
-    scripts/bvh-scorecard RESULTS.csv [--targets issue33|issue4|issue33,issue4]
+    scripts/bvh-scorecard RESULTS.csv [--targets issue33|issue4|issue32|issue33,issue4]
                           [--out SCORECARD.md | --machine-dir DIR] [--plot PICTURE.png | --no-plot]
     scripts/bvh-scorecard --run [--dry-run] [--machine-dir DIR] [--backend LIST] [-- RAYBENCH OPTIONS]
     scripts/bvh-scorecard --index DIR
 
 Issue 33's targets (the default), the machine class, the index of every class and --run's
 command: machine_scorecard.py. This file: the command line, and issue 4's targets (--targets
-issue4, which reproduces the scorecards made before issue 33). For every scene and the primary, diffuse and shadow ray sets (one thread), it compares:
+issue4, which reproduces the scorecards made before issue 33). --targets issue32: the coherent
+scorecard (machine_scorecard.render_coherent_card) of a run of meshes/coherent.toml. For every scene and the primary, diffuse and shadow ray sets (one thread), it compares:
 - our best backend (every backend not named embree* or reference) with Embree's best (the faster
   of `embree` and `embree:high`, when the run has both): target >= 1.0 per scene and ray set,
   and >= 1.10 as a geometric mean;
@@ -334,7 +335,7 @@ def render(lines, meta, source, rows=(), plot=None):
     return "\n".join(out) + "\n"
 
 
-TARGET_SETS = ("issue33", "issue4")
+TARGET_SETS = ("issue33", "issue4", "issue32")
 # The one command of a machine's scorecard (--run): the default suite's four ray kinds, one and two
 # threads, Embree's medium and high builds beside bvh8, our best candidates and the watertight ones.
 RUN_BACKENDS = ("embree,embree:high,bvh8,bvh8:reinsert,bvh8:sbvh:reinsert,bvh8:mt_edges,bvh8:watertight,"
@@ -346,7 +347,7 @@ def target_sets(text):
     names = [t.strip() for t in text.split(",") if t.strip()]
     unknown = [t for t in names if t not in TARGET_SETS]
     if unknown or not names:
-        raise argparse.ArgumentTypeError(f"unknown target set '{','.join(unknown) or text}' (known: issue33, issue4)")
+        raise argparse.ArgumentTypeError(f"unknown target set '{','.join(unknown) or text}' (known: issue33, issue4, issue32)")
     return list(dict.fromkeys(names))
 
 
@@ -389,7 +390,15 @@ def scorecard_text(rows, meta, source, sets, plot):
     and the summary of issue 33's scorecard (None when it is not the first set)."""
     import machine_scorecard
     lines = scorecard(rows)
-    if sets[0] == "issue33":
+    if sets[0] == "issue32":
+        if not machine_scorecard.coherent_rows_of(rows):
+            raise InputError(source, "no single-thread tiled, diffuse or uniform rows with a packet backend of ours "
+                                     "(run meshes/coherent.toml)")
+        if not meta:
+            raise InputError(source, "no metadata beside it (.meta.toml): the coherent scorecard names the machine "
+                                     "class from it")
+        out, facts = machine_scorecard.render_coherent_card(rows, meta, source, plot), None
+    elif sets[0] == "issue33":
         if not meta:
             raise InputError(source, "no metadata beside it (.meta.toml): issue 33's scorecard names the machine "
                                      "class from it (or pass --targets issue4)")
@@ -427,14 +436,24 @@ def write_scorecard(results, sets, out, plot, machine_dir):
     if machine_dir:
         if not meta:
             raise InputError(results, "no metadata beside it (.meta.toml): cannot name the machine class")
-        name = machine_scorecard.machine_class(meta)
+        name = machine_scorecard.machine_class(meta) + ("-coherent" if sets[0] == "issue32" else "")
         out = os.path.join(machine_dir, name + ".md")
         plot = None if plot is False else os.path.join(machine_dir, name + ".png")
     elif plot is None:
         plot = os.path.splitext(out)[0] + ".png" if out else None
     link = None
     if plot:
-        if sets[0] == "issue33":
+        if sets[0] == "issue32":
+            lines = machine_scorecard.coherent_plot_lines(rows)
+            title = "Issue 32: coherent rays, our packets against Embree's packets and streams, one thread"
+            if meta.get("cpu_id"):
+                title += f" ({machine_scorecard.machine_class(meta)})"
+            if lines:
+                plot_scorecard(plot, lines, title, machine_scorecard.COHERENT_PANELS,
+                               machine_scorecard.TILED_KINDS + machine_scorecard.INCOHERENT_KINDS)
+            else:
+                plot = None
+        elif sets[0] == "issue33":
             lines = machine_scorecard.rows_of(rows)
             panels = (("bvh8_embree", "bvh8_embree_range", "bvh8 / embree", 1.05),
                       ("best_best", "best_best_range", "our best / Embree's best", 1.10),
@@ -471,7 +490,8 @@ def main(argv=None):
     parser.add_argument("results", nargs="?", help="results CSV of a run with embree (and embree:high) beside our backends")
     parser.add_argument("--targets", type=target_sets, default=["issue33"],
                         help="target sets, the first the scorecard's, the others' tables after it: issue33 (default), "
-                             "issue4, or both as issue33,issue4")
+                             "issue4, or both as issue33,issue4; issue32 alone: the coherent scorecard of a run of "
+                             "meshes/coherent.toml (with --machine-dir: DIR/<class>-coherent.md)")
     parser.add_argument("--out", help="write the Markdown here instead of stdout")
     parser.add_argument("--machine-dir", help="write DIR/<machine class>.md (+ .png) and regenerate DIR/README.md, the "
                                               "index; with --run, where the run goes (default results/scorecards)")

@@ -413,6 +413,32 @@ class MachineScorecard(unittest.TestCase):
         self.assertIn("## Issue 33's targets", out)
         self.assertNotIn("Coherent rays", out)
 
+    def test_targets_issue32_is_the_coherent_card_alone_written_beside_the_machine_scorecard(self):
+        with tempfile.TemporaryDirectory() as d:
+            run = write_run(d, "run", coherent_run(), INTEL)
+            cards = os.path.join(d, "cards")
+            os.mkdir(cards)
+            result = scorecard_cli(run, "--targets", "issue32", "--machine-dir", cards)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            with open(os.path.join(cards, "intel-family6-model167-coherent.md"), encoding="utf-8") as f:
+                out = f.read()
+            self.assertTrue(os.path.exists(os.path.join(cards, "intel-family6-model167-coherent.png")))
+            with open(os.path.join(cards, "README.md"), encoding="utf-8") as f:
+                index = f.read()
+            # Not a class's issue-33 scorecard: only the header and issue 32's section.
+            self.assertFalse(os.path.exists(os.path.join(cards, "intel-family6-model167.md")))
+            self.assertIn("# Scorecard of machine class intel-family6-model167: coherent rays", out)
+            self.assertNotIn("Issue 33's targets", out)
+            self.assertIn("### Issue 32's targets: 0 of 3 met", out)
+            self.assertIn("![ours against Embree's best coherent mode", out)
+            self.assertIn("[intel-family6-model167](intel-family6-model167-coherent.md)", index)
+            # A run without a packet backend of ours has no coherent card: one line, exit 2.
+            single = write_run(d, "single", [r for r in coherent_run() if "packet" not in r["backend"]], INTEL)
+            refused = scorecard_cli(single, "--targets", "issue32", "--no-plot")
+            self.assertEqual(refused.returncode, 2)
+            self.assertEqual(len(refused.stderr.strip().splitlines()), 1, refused.stderr)
+            self.assertIn("no single-thread tiled, diffuse or uniform rows with a packet backend of ours", refused.stderr)
+
     def test_a_target_whose_rows_the_run_lacks_is_not_measurable_never_met(self):
         rows = [r for r in issue33_run() if r["rayset"] != "uniform" and r["threads"] == 1]
         with tempfile.TemporaryDirectory() as d:

@@ -379,11 +379,11 @@ def missing_suite_scenes(meta, suite=DEFAULT_SUITE):
     return [n for n in names if n and n not in ran]
 
 
-def header(meta, source):
+def header(meta, source, subject="our BVHs against Embree (issue 33)"):
     """The scorecard's opening: the machine class, the CPU and its ISA, the build, Embree's configuration."""
     cls = machine_class(meta)
     isa = cpu_isa(meta)
-    out = [f"# Scorecard of machine class {cls}: our BVHs against Embree (issue 33)", "",
+    out = [f"# Scorecard of machine class {cls}: {subject}", "",
            f"From `{os.path.basename(source)}`, one thread unless said, ratios within the run.", "",
            f"CPU: {meta.get('cpu', 'not recorded')} ({meta.get('cpu_id', 'cpu_id not recorded')}); "
            f"ISA: {isa or 'not recorded'}; built with {meta.get('compiler', 'an unrecorded compiler')}, "
@@ -439,6 +439,30 @@ def render(rows, meta, source, plot=None):
     return out, summary(meta, lines, evaluated, source)
 
 
+COHERENT_PANELS = (("coh_coh", "coh_coh_range", "ours / Embree's best coherent", 1.30),
+                   ("coh_embree", "coh_embree_range", "ours / embree", 2.0),
+                   ("packet_single", "packet_single_range", "packet / single-ray", 0.95))
+
+
+def coherent_plot_lines(rows):
+    """The coherent lines with every panel's key (None where a kind has no such ratio), for the plot."""
+    lines = coherent_rows_of(rows)
+    for x in lines:
+        for key, range_key, _, _ in COHERENT_PANELS:
+            x.setdefault(key, None)
+            x.setdefault(range_key, None)
+    return lines
+
+
+def render_coherent_card(rows, meta, source, plot=None):
+    """The coherent scorecard of a coherent run (meshes/coherent.toml): the header and issue 32's
+    section alone, in Markdown lines."""
+    out = header(meta, source, "coherent rays, our packets against Embree's packets and streams (issue 32)")
+    if plot:
+        out += ["", f"![ours against Embree's best coherent mode and against embree, per scene and ray kind]({plot})"]
+    return out + render_coherent(rows)
+
+
 def summary_comment(facts):
     return SUMMARY_MARK + json.dumps(facts, sort_keys=True) + " -->"
 
@@ -490,6 +514,11 @@ def write_index(directory):
     if count == 0:
         text.append("")
         text.append("No scorecard yet.")
+    coherent = sorted(n for n in os.listdir(directory) if n.endswith("-coherent.md"))
+    if coherent:
+        text += ["", "Coherent rays (issue 32: our packets against Embree's packets and streams, from a run of "
+                 "`meshes/coherent.toml`, `scripts/bvh-scorecard RUN.csv --targets issue32 --machine-dir "
+                 "results/scorecards`): " + ", ".join(f"[{n[:-len('-coherent.md')]}]({n})" for n in coherent) + "."]
     with open(os.path.join(directory, "README.md"), "w", encoding="utf-8") as f:
         f.write("\n".join(text) + "\n")
     return count
