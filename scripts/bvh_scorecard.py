@@ -239,7 +239,9 @@ def plot_scorecard(path, lines, title, panels=ISSUE4_PANELS, kinds=RAYSETS):
     fig, axes = plt.subplots(len(panels), 1, figsize=(figure_width(groups, len(kinds)), 3.6 * len(panels)),
                              layout="constrained", squeeze=False)
     for ax, (key, range_key, label, target) in zip(axes[:, 0], panels):
-        means = {rs: geometric_mean([x[key] for x in lines if x["rayset"] == rs]) for rs in kinds}
+        # The ray kinds this panel has ratios of (the coherent card's panels each have two).
+        panel_kinds = [k for k in kinds if any(x["rayset"] == k and x[key] is not None for x in lines)]
+        means = {rs: geometric_mean([x[key] for x in lines if x["rayset"] == rs]) for rs in panel_kinds}
 
         def value_of(scene, rayset):
             if scene == "geo. mean":
@@ -249,7 +251,7 @@ def plot_scorecard(path, lines, title, panels=ISSUE4_PANELS, kinds=RAYSETS):
                 return None
             span = x[range_key]
             return (x[key], span[0], span[1]) if span else (x[key], None, None)
-        draw_grouped_bars(ax, groups, kinds, colors, value_of)
+        draw_grouped_bars(ax, groups, panel_kinds, colors, value_of)
         ax.axhline(target, color="black", linewidth=1.2, linestyle="--", zorder=4, label=f"target (= {target:g})")
         ax.axvline(len(scenes) - 0.5, color="grey", linewidth=0.8, zorder=1)
         values = [v for x in lines for v in (x[key], *(x[range_key] or ())) if v is not None]
