@@ -459,51 +459,72 @@ inline unsigned packet_lanes(const Ray* rays, int n, const BBox& extent) {
 #endif
 }
 
-// Closest hit of every ray, consecutive coherent rays traced as packets
-// (plan_packet), the others alone, and a batch whose first groups all look
-// incoherent by intersect_wide_batch itself: the same Hit for every ray as
-// intersect_wide_batch. Screened rays, as wide_bvh_batch.h's loops.
-template <typename Leaf>
-inline void intersect_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, std::span<Hit> hits) {
-  constexpr bool kSlots = !Leaf::kPrimsInPack;
 #if defined(__AVX2__)
-  const float max_origin_distance = bvh.nodes.empty() ? 0.0f : kMaxPacketOriginSpread * length(bvh.bounds.extent());
-  if (bvh.nodes.empty() || !wide_packet_detail::batch_looks_coherent(rays, max_origin_distance))
-    return intersect_wide_batch<Leaf, SlabFma>(bvh, rays, hits);
+namespace wide_packet_detail {
+
+// The batch loop of both queries, for a batch that looks coherent: each
+// group's planned rays traced as one packet by in_packet(first, packet,
+// plan), the others by alone(index).
+template <typename Alone, typename InPacket>
+void trace_groups(const Bvh8& bvh, std::span<const Ray> rays, float max_origin_distance, Alone&& alone,
+                  InPacket&& in_packet) {
   for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
     const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
-    wide_packet_detail::Packet p;
+    Packet p;
     const PacketPlan plan = plan_packet(&rays[first], n, max_origin_distance, bvh.bounds, p);
     for (int i = 0; i < n; ++i)
-      if (!(plan.lanes >> i & 1u)) hits[first + i] = traverse_wide<false, Leaf, SlabFma, kSlots>(bvh, rays[first + i]);
-    if (plan.lanes) trace_packet<false, Leaf, kSlots>(bvh, &rays[first], p, plan, &hits[first], nullptr);
+      if (!(plan.lanes >> i & 1u)) alone(first + static_cast<std::size_t>(i));
+    if (plan.lanes) in_packet(first, p, plan);
   }
-#else
-  for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = traverse_wide<false, Leaf, SlabFma, kSlots>(bvh, rays[i]);
+}
+
+inline float max_origin_distance(const Bvh8& bvh) { return kMaxPacketOriginSpread * length(bvh.bounds.extent()); }
+
+}  // namespace wide_packet_detail
 #endif
-  if constexpr (kSlots)
-    for (Hit& h : hits)
-      if (h.hit()) h.prim = bvh.pack_prims[static_cast<std::uint32_t>(h.prim)];
+
+// Closest hit of every ray, consecutive coherent rays traced as packets
+// (plan_packet), the others alone, and a batch whose first groups all look
+// incoherent (or any batch without AVX2) by intersect_wide_batch itself:
+// the same Hit for every ray as intersect_wide_batch. Screened rays, as
+// wide_bvh_batch.h's loops.
+template <typename Leaf>
+inline void intersect_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, std::span<Hit> hits) {
+#if defined(__AVX2__)
+  using namespace wide_packet_detail;
+  constexpr bool kSlots = !Leaf::kPrimsInPack;
+  if (!bvh.nodes.empty() && batch_looks_coherent(rays, max_origin_distance(bvh))) {
+    trace_groups(
+        bvh, rays, max_origin_distance(bvh),
+        [&](std::size_t i) { hits[i] = traverse_wide<false, Leaf, SlabFma, kSlots>(bvh, rays[i]); },
+        [&](std::size_t first, const Packet& p, PacketPlan plan) {
+          trace_packet<false, Leaf, kSlots>(bvh, &rays[first], p, plan, &hits[first], nullptr);
+        });
+    if constexpr (kSlots)
+      for (Hit& h : hits)
+        if (h.hit()) h.prim = bvh.pack_prims[static_cast<std::uint32_t>(h.prim)];
+    return;
+  }
+#endif
+  intersect_wide_batch<Leaf, SlabFma>(bvh, rays, hits);
 }
 
 // Any hit of every ray, as occluded_wide_batch, packets as above.
 template <typename Leaf>
 inline void occluded_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, std::span<std::uint8_t> occluded) {
 #if defined(__AVX2__)
-  const float max_origin_distance = bvh.nodes.empty() ? 0.0f : kMaxPacketOriginSpread * length(bvh.bounds.extent());
-  if (bvh.nodes.empty() || !wide_packet_detail::batch_looks_coherent(rays, max_origin_distance))
-    return occluded_wide_batch<Leaf, SlabFma>(bvh, rays, occluded);
-  for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
-    const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
-    wide_packet_detail::Packet p;
-    const PacketPlan plan = plan_packet(&rays[first], n, max_origin_distance, bvh.bounds, p);
-    for (int i = 0; i < n; ++i)
-      if (!(plan.lanes >> i & 1u)) occluded[first + i] = occluded_wide<Leaf, SlabFma>(bvh, rays[first + i]);
-    if (plan.lanes) trace_packet<true, Leaf, false>(bvh, &rays[first], p, plan, nullptr, &occluded[first]);
+  using namespace wide_packet_detail;
+  if (!bvh.nodes.empty() && batch_looks_coherent(rays, max_origin_distance(bvh))) {
+    trace_groups(
+        bvh, rays, max_origin_distance(bvh),
+        [&](std::size_t i) { occluded[i] = occluded_wide<Leaf, SlabFma>(bvh, rays[i]); },
+        [&](std::size_t first, const Packet& p, PacketPlan plan) {
+          trace_packet<true, Leaf, false>(bvh, &rays[first], p, plan, nullptr, &occluded[first]);
+        });
+    return;
   }
-#else
-  for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = occluded_wide<Leaf, SlabFma>(bvh, rays[i]);
 #endif
+  occluded_wide_batch<Leaf, SlabFma>(bvh, rays, occluded);
 }
 
 }  // namespace raybench

@@ -217,13 +217,21 @@ struct FloatLanes<16> {
     return {_mm512_castsi512_ps(_mm512_and_si512(_mm512_set1_epi32(INT32_MIN), _mm512_castps_si512(v)))};
   }
 };
-inline FloatLanes<16> max(FloatLanes<16> a, FloatLanes<16> b) { return {_mm512_max_ps(a.v, b.v)}; }
-inline FloatLanes<16> min(FloatLanes<16> a, FloatLanes<16> b) { return {_mm512_min_ps(a.v, b.v)}; }
+// max/min in their zero-masking form under a full mask: the same instruction
+// (GCC 12's plain _mm512_max_ps/_mm512_min_ps warn of an undefined operand).
+inline FloatLanes<16> max(FloatLanes<16> a, FloatLanes<16> b) { return {_mm512_maskz_max_ps(0xffff, a.v, b.v)}; }
+inline FloatLanes<16> min(FloatLanes<16> a, FloatLanes<16> b) { return {_mm512_maskz_min_ps(0xffff, a.v, b.v)}; }
 inline FloatLanes<16> fmadd(FloatLanes<16> a, FloatLanes<16> b, FloatLanes<16> c) { return {_mm512_fmadd_ps(a.v, b.v, c.v)}; }
 inline FloatLanes<16> fmsub(FloatLanes<16> a, FloatLanes<16> b, FloatLanes<16> c) { return {_mm512_fmsub_ps(a.v, b.v, c.v)}; }
 inline FloatLanes<16> select(LaneMask16 m, FloatLanes<16> a, FloatLanes<16> b) { return {_mm512_mask_blend_ps(m.k, b.v, a.v)}; }
-inline float reduce_min(FloatLanes<16> x) { return _mm512_reduce_min_ps(x.v); }
-inline float reduce_max(FloatLanes<16> x) { return _mm512_reduce_max_ps(x.v); }
+// The lower or upper 8 lanes (AVX-512F alone: through the 64-bit form,
+// zero-masked under a full mask for GCC 12's sake as above).
+template <int Half>
+inline FloatLanes<8> half_of(FloatLanes<16> x) {
+  return {_mm256_castpd_ps(_mm512_maskz_extractf64x4_pd(0xff, _mm512_castps_pd(x.v), Half))};
+}
+inline float reduce_min(FloatLanes<16> x) { return reduce_min(min(half_of<0>(x), half_of<1>(x))); }
+inline float reduce_max(FloatLanes<16> x) { return reduce_max(max(half_of<0>(x), half_of<1>(x))); }
 #endif
 
 }  // namespace raybench::simd
