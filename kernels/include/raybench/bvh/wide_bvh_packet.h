@@ -61,6 +61,8 @@ inline constexpr int kAloneAtMost = kPacketRays == 16 ? 3 : 1;
 // looser ones (0.9 and 5 % or more) cost diffuse and uniform rays up to 8 %.
 inline constexpr float kMinPacketCosine = 0.97f;        // directions within about 14 degrees of the first ray's
 inline constexpr float kMaxPacketOriginSpread = 0.05f;  // of the tree's bounds diagonal
+// kMaxPacketOriginSpread of the diagonal of `extent`, a tree's bounds.
+inline float max_packet_origin_distance(const BBox& extent) { return kMaxPacketOriginSpread * length(extent.extent()); }
 
 // The rays of a group traced as one packet (bit i: ray i of the group), and
 // their shared octant; lanes == 0: every ray alone.
@@ -328,6 +330,10 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
   // the occluded rays.
   const float kDone = -std::numeric_limits<float>::infinity();
   unsigned done = 0;
+  const auto mark_occluded = [&](unsigned lanes) {
+    done |= lanes;
+    for (; lanes; lanes &= lanes - 1) tmax[std::countr_zero(lanes)] = kDone;
+  };
   F reach = F::load(tmax);  // SlabFma is not conservative: a subtree is skipped when farther than tmax
   F exit = min(reach, F::set1(kLargest));
   PacketStack stack;
@@ -344,10 +350,7 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
       for (unsigned lanes = active; lanes; lanes &= lanes - 1) {
         const int i = std::countr_zero(lanes);
         if constexpr (AnyHit) {
-          if (traverse_wide_from<true, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, Hit{})) {
-            tmax[i] = kDone;
-            done |= 1u << i;
-          }
+          if (traverse_wide_from<true, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, Hit{})) mark_occluded(1u << i);
         } else {
           hit[i] = traverse_wide_from<false, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, hit[i]);
           if (hit[i].hit()) tmax[i] = hit[i].t;
@@ -366,8 +369,7 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
           hit_rays = intersect_pack_rays(p, node_tnear, bvh.edge_packs[pack], best_t, u, v, lane_of);
         if (hit_rays) {
           if constexpr (AnyHit) {
-            for (unsigned lanes = hit_rays; lanes; lanes &= lanes - 1) tmax[std::countr_zero(lanes)] = kDone;
-            done |= hit_rays;
+            mark_occluded(hit_rays);
           } else {
             alignas(64) float us[kPacketRays], vs[kPacketRays];
             best_t.storeu(tmax);
@@ -375,9 +377,7 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
             v.storeu(vs);
             for (unsigned lanes = hit_rays; lanes; lanes &= lanes - 1) {
               const int i = std::countr_zero(lanes);
-              const std::int32_t prim = PackSlots ? static_cast<std::int32_t>(Bvh8::slot(pack, lane_of[i]))
-                                                  : Leaf::prim(bvh, pack, lane_of[i]);
-              hit[i] = {tmax[i], prim, us[i], vs[i]};
+              hit[i] = pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane_of[i], tmax[i], us[i], vs[i]);
             }
           }
           update_bounds();
@@ -391,12 +391,10 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
           if (lane < 0) continue;
           any = true;
           if constexpr (AnyHit) {
-            tmax[i] = kDone;
-            done |= 1u << i;
+            mark_occluded(1u << i);
           } else {
             tmax[i] = th.t;
-            if constexpr (PackSlots) hit[i] = {th.t, static_cast<std::int32_t>(Bvh8::slot(pack, lane)), th.u, th.v};
-            else hit[i] = {th.t, Leaf::prim(bvh, pack, lane), th.u, th.v};
+            hit[i] = pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane, th.t, th.u, th.v);
           }
         }
         if (any) update_bounds();
@@ -452,7 +450,7 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
 inline unsigned packet_lanes(const Ray* rays, int n, const BBox& extent) {
 #if defined(__AVX2__)
   wide_packet_detail::Packet p;
-  return plan_packet(rays, n, kMaxPacketOriginSpread * length(extent.extent()), extent, p).lanes;
+  return plan_packet(rays, n, max_packet_origin_distance(extent), extent, p).lanes;
 #else
   (void)rays, (void)n, (void)extent;
   return 0;
@@ -478,10 +476,9 @@ void trace_groups(const Bvh8& bvh, std::span<const Ray> rays, float max_origin_d
   }
 }
 
-inline float max_origin_distance(const Bvh8& bvh) { return kMaxPacketOriginSpread * length(bvh.bounds.extent()); }
-
 }  // namespace wide_packet_detail
 #endif
+
 
 // Closest hit of every ray, consecutive coherent rays traced as packets
 // (plan_packet), the others alone, and a batch whose first groups all look
@@ -493,9 +490,10 @@ inline void intersect_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, s
 #if defined(__AVX2__)
   using namespace wide_packet_detail;
   constexpr bool kSlots = !Leaf::kPrimsInPack;
-  if (!bvh.nodes.empty() && batch_looks_coherent(rays, max_origin_distance(bvh))) {
+  const float max_origin_distance = max_packet_origin_distance(bvh.bounds);
+  if (!bvh.nodes.empty() && batch_looks_coherent(rays, max_origin_distance)) {
     trace_groups(
-        bvh, rays, max_origin_distance(bvh),
+        bvh, rays, max_origin_distance,
         [&](std::size_t i) { hits[i] = traverse_wide<false, Leaf, SlabFma, kSlots>(bvh, rays[i]); },
         [&](std::size_t first, const Packet& p, PacketPlan plan) {
           trace_packet<false, Leaf, kSlots>(bvh, &rays[first], p, plan, &hits[first], nullptr);
@@ -514,9 +512,10 @@ template <typename Leaf>
 inline void occluded_packet_batch(const Bvh8& bvh, std::span<const Ray> rays, std::span<std::uint8_t> occluded) {
 #if defined(__AVX2__)
   using namespace wide_packet_detail;
-  if (!bvh.nodes.empty() && batch_looks_coherent(rays, max_origin_distance(bvh))) {
+  const float max_origin_distance = max_packet_origin_distance(bvh.bounds);
+  if (!bvh.nodes.empty() && batch_looks_coherent(rays, max_origin_distance)) {
     trace_groups(
-        bvh, rays, max_origin_distance(bvh),
+        bvh, rays, max_origin_distance,
         [&](std::size_t i) { occluded[i] = occluded_wide<Leaf, SlabFma>(bvh, rays[i]); },
         [&](std::size_t first, const Packet& p, PacketPlan plan) {
           trace_packet<true, Leaf, false>(bvh, &rays[first], p, plan, nullptr, &occluded[first]);

@@ -169,6 +169,14 @@ struct Bvh8Watertight {
   }
 };
 
+// The Hit at (t, u, v) on lane `lane` of pack `pack`: its input triangle,
+// or with PackSlots its pack slot (WideBvh::slot), for the caller to map.
+template <typename Leaf, bool PackSlots, int W>
+RAYBENCH_INLINE Hit pack_lane_hit(const WideBvh<W>& bvh, std::uint32_t pack, int lane, float t, float u, float v) {
+  if constexpr (PackSlots) return {t, static_cast<std::int32_t>(WideBvh<W>::slot(pack, lane)), u, v};
+  else return {t, Leaf::prim(bvh, pack, lane), u, v};
+}
+
 // Inlined into the caller's loop over rays: called, the ray a backend has
 // just adjusted (with_nonnegative_tnear) goes through memory, where the
 // traversal's first loads of it likely span two stores and wait for them
@@ -236,8 +244,7 @@ RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide_from(const W
         // the traversal never reads otherwise, and the answer waited for it
         // (measured: docs/notes/kernels-wide-traversal.md).
         if constexpr (AnyHit) return true;
-        else if constexpr (PackSlots) hit = {th.t, static_cast<std::int32_t>(WideBvh<W>::slot(pack, lane)), th.u, th.v};
-        else hit = {th.t, Leaf::prim(bvh, pack, lane), th.u, th.v};
+        else hit = pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane, th.t, th.u, th.v);
       }
     } else {
       const WideNode<W>& node = bvh.nodes[ref];
