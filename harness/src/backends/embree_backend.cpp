@@ -359,14 +359,11 @@ struct Packet<16> {
 };
 
 // The fields of a packet Embree never writes, for every lane: every mask
-// bit, id, flags, time 0; and kEmptyRay in every lane until load_packet
-// writes it.
+// bit, id, flags, time 0 (load_packet writes the rays, every lane, before
+// each call).
 template <int K, typename RayK>
 void init_packet(RayK& packet) {
   for (int i = 0; i < K; ++i) {
-    packet.org_x[i] = kEmptyRay.org.x, packet.org_y[i] = kEmptyRay.org.y, packet.org_z[i] = kEmptyRay.org.z;
-    packet.dir_x[i] = kEmptyRay.dir.x, packet.dir_y[i] = kEmptyRay.dir.y, packet.dir_z[i] = kEmptyRay.dir.z;
-    packet.tnear[i] = kEmptyRay.tnear, packet.tfar[i] = kEmptyRay.tfar;
     packet.time[i] = 0.0f;
     packet.mask[i] = 0xffffffffu;
     packet.id[i] = 0;
@@ -557,7 +554,9 @@ class EmbreeBackend final : public Backend {
     return context;
   }
 
-  // An answer of Embree's into ours, as intersect_rays writes it.
+  // An answer of Embree's into ours, for every ray mode: a miss, or the
+  // global prim id (first_id_ of its geometry plus primID, with u = v = 0
+  // for an analytic hit: prim/analytic_hit.h).
   template <bool Analytic>
   Hit hit_of(unsigned geom_id, unsigned prim_id, float t, float u, float v) const {
     if (geom_id == RTC_INVALID_GEOMETRY_ID) return Hit{};
@@ -659,16 +658,7 @@ class EmbreeBackend final : public Backend {
       load(rh.ray, rays[i]);
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(scene_, &context, &rh);
-      // Each answer written once.
-      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-        hits[i] = Hit{};
-      } else if constexpr (Analytic) {
-        const bool triangle = rh.hit.geomID == kTriangleGeometry;
-        hits[i] = {rh.ray.tfar, static_cast<std::int32_t>(first_id_[rh.hit.geomID] + rh.hit.primID),
-                   triangle ? rh.hit.u : 0.0f, triangle ? rh.hit.v : 0.0f};
-      } else {
-        hits[i] = {rh.ray.tfar, static_cast<std::int32_t>(rh.hit.primID), rh.hit.u, rh.hit.v};
-      }
+      hits[i] = hit_of<Analytic>(rh.hit.geomID, rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v);  // written once
     }
   }
 
