@@ -209,6 +209,19 @@ def build_target(text, builds, absent):
     return {**target, "status": "met" if not target["misses"] else "missed", "measured": measured}
 
 
+def geomean_target(text, values, missing, threshold):
+    """A geometric-mean target: met when the mean of `values` reaches `threshold`; not measurable
+    without values or when the run lacks the ray kinds in `missing`."""
+    mean = geometric_mean(values)
+    target = {"text": text, "misses": []}
+    if mean is None or missing:
+        target.update(status="not measurable", measured="no rows" if mean is None else
+                      f"{mean:.2f}; the run has no {', '.join(missing)} rows")
+    else:
+        target.update(status="met" if mean >= threshold else "missed", measured=f"{mean:.2f} over {len(values)} rows")
+    return target
+
+
 def targets(lines, rows):
     """Issue 33's targets evaluated on the run: a list of {text, status, measured, misses}."""
     out = [
@@ -219,14 +232,8 @@ def targets(lines, rows):
     ]
     traced = [x["best_best"] for x in lines if x["rayset"] in TRACED_KINDS and x["best_best"] is not None]
     missing = [k for k in TRACED_KINDS if not any(x["rayset"] == k for x in lines)]
-    mean = geometric_mean(traced)
-    geo = {"text": "our best ≥ 1.30 × Embree's best, geometric mean over primary, diffuse, shadow", "misses": []}
-    if mean is None or missing:
-        geo.update(status="not measurable", measured="no rows" if mean is None else
-                   f"{mean:.2f}; the run has no {', '.join(missing)} rows")
-    else:
-        geo.update(status="met" if mean >= 1.30 else "missed", measured=f"{mean:.2f} over {len(traced)} rows")
-    out.append(geo)
+    out.append(geomean_target("our best ≥ 1.30 × Embree's best, geometric mean over primary, diffuse, shadow", traced,
+                              missing, 1.30))
     out.append(per_row_target("our best ≥ 1.10 × Embree's best, every row (primary, diffuse, shadow)", lines,
                               "best_best", 1.10, TRACED_KINDS, "no backend of ours"))
     out.append(per_row_target("watertight ≥ 1.05 × `embree`, every row (primary, diffuse, shadow, uniform)", lines,
@@ -297,15 +304,8 @@ def coherent_targets(lines):
                           "no Embree packet or stream mode beside a packet backend of ours")]
     values = [x["coh_embree"] for x in tiled if x["coh_embree"] is not None]
     missing = [k for k in TILED_KINDS if not any(x["rayset"] == k and x["coh_embree"] is not None for x in tiled)]
-    mean = geometric_mean(values)
-    geo = {"text": "our best coherent ≥ 2.0 × `embree` (rtcIntersect1), geometric mean over primary-tiled, "
-                   "shadow-tiled", "misses": []}
-    if mean is None or missing:
-        geo.update(status="not measurable", measured="no rows" if mean is None else
-                   f"{mean:.2f}; the run has no {', '.join(missing)} rows")
-    else:
-        geo.update(status="met" if mean >= 2.0 else "missed", measured=f"{mean:.2f} over {len(values)} rows")
-    out.append(geo)
+    out.append(geomean_target("our best coherent ≥ 2.0 × `embree` (rtcIntersect1), geometric mean over primary-tiled, "
+                              "shadow-tiled", values, missing, 2.0))
     out.append(per_row_target("every packet backend of ours ≥ 0.95 × itself without `packet`, every row (diffuse, "
                               "uniform)", [x for x in lines if x["rayset"] in INCOHERENT_KINDS], "packet_single", 0.95,
                               INCOHERENT_KINDS, "no packet backend of ours beside its single-ray twin"))
