@@ -129,29 +129,29 @@ inline bool batch_looks_coherent(std::span<const Ray> rays, float max_origin_dis
 inline PacketPlan plan_packet(const Ray* rays, int n, float max_origin_distance, const BBox& extent, Packet& p) {
   constexpr float kInf = std::numeric_limits<float>::infinity();
   if (!looks_coherent(rays, n, max_origin_distance)) return {};
-  alignas(64) float soa[8][kPacketRays];  // ox oy oz tnear dx dy dz tfar, as a Ray's 8 floats
-  for (int i = 0; i < kPacketRays; ++i) {
-    const float* ray = reinterpret_cast<const float*>(i < n ? &rays[i] : nullptr);
-    for (int k = 0; k < 8; ++k) soa[k][i] = i < n ? ray[k] : std::numeric_limits<float>::quiet_NaN();
-  }
+  // Field k of a Ray's 8 floats (ox oy oz tnear dx dy dz tfar) of each ray, NaN beyond n.
+  static_assert(sizeof(Ray) == 8 * sizeof(float));
+  const auto field = [&](int k) {
+    return F::gather(reinterpret_cast<const float*>(rays) + k, 8, n, std::numeric_limits<float>::quiet_NaN());
+  };
   const F inf = F::set1(kInf);
   auto usable = F::set1(0.0f) <= F::set1(0.0f);  // every lane
   for (int a = 0; a < 3; ++a) {
-    p.org[a] = F::load(soa[a]);
-    p.dir[a] = F::load(soa[4 + a]);
+    p.org[a] = field(a);
+    p.dir[a] = field(4 + a);
     p.inv_dir[a] = F::set1(1.0f) / p.dir[a];  // Slab::precompute's 1/d, rounded alike
     p.fused[a] = p.org[a] * p.inv_dir[a];
     usable = usable & (p.org[a].abs() < inf) & (p.dir[a].abs() < inf) & (p.inv_dir[a].abs() < inf);
   }
-  p.tnear = F::load(soa[3]);
+  p.tnear = field(3);
   const unsigned usable_rays = usable.mask();
   if (usable_rays == 0) return {};
   const int lead = std::countr_zero(usable_rays);
   if (lead + kMinPacketRays > n) return {};
   std::array<F, 3> lead_org, lead_dir;
   for (int a = 0; a < 3; ++a) {
-    lead_org[a] = F::set1(soa[a][lead]);
-    lead_dir[a] = F::set1(soa[4 + a][lead]);
+    lead_org[a] = F::set1(rays[lead].org[a]);
+    lead_dir[a] = F::set1(rays[lead].dir[a]);
   }
   const auto dot = [](const std::array<F, 3>& x, const std::array<F, 3>& y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
   const F cosine = dot(p.dir, lead_dir);
@@ -166,7 +166,7 @@ inline PacketPlan plan_packet(const Ray* rays, int n, float max_origin_distance,
   plan.lanes = in.mask();
   if (std::popcount(plan.lanes) < kMinPacketRays) return {};
   for (int a = 0; a < 3; ++a) {
-    const bool negative = std::signbit(soa[4 + a][lead]);
+    const bool negative = std::signbit(rays[lead].dir[a]);
     plan.octant |= static_cast<int>(negative) << a;
     p.near_offset[a] = negative ? 3 * 8 : 0;
     const float inv_lo = simd::reduce_min(select(in, p.inv_dir[a], inf));
@@ -182,7 +182,7 @@ inline PacketPlan plan_packet(const Ray* rays, int n, float max_origin_distance,
     p.fused_lo[a] = F8::set1(fused_lo - pad);
   }
   p.tnear_min = F8::set1(simd::reduce_min(select(in, p.tnear, inf)));
-  const F exit_bound = min(F::load(soa[7]), F::set1(std::numeric_limits<float>::max()));  // box_exit_bound<SlabFma>
+  const F exit_bound = min(field(7), F::set1(std::numeric_limits<float>::max()));  // box_exit_bound<SlabFma>
   p.exit_max = F8::set1(simd::reduce_max(select(in, exit_bound, F::set1(-kInf))));
   return plan;
 }

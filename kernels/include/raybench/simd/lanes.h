@@ -64,6 +64,12 @@ struct FloatLanes<8> {
   __m256 v;
   static FloatLanes set1(float x) { return {_mm256_set1_ps(x)}; }
   static FloatLanes load(const float* p) { return {_mm256_load_ps(p)}; }
+  // Lane i is p[i * stride] for i < n (nothing beyond is read), `fill` in the others.
+  static FloatLanes gather(const float* p, int stride, int n, float fill) {
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256 in = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(n), lane));
+    return {_mm256_mask_i32gather_ps(_mm256_set1_ps(fill), p, _mm256_mullo_epi32(lane, _mm256_set1_epi32(stride)), in, 4)};
+  }
   void storeu(float* p) const { _mm256_storeu_ps(p, v); }
   FloatLanes operator+(FloatLanes o) const { return {_mm256_add_ps(v, o.v)}; }
   FloatLanes operator-(FloatLanes o) const { return {_mm256_sub_ps(v, o.v)}; }
@@ -198,6 +204,13 @@ struct FloatLanes<16> {
   __m512 v;
   static FloatLanes set1(float x) { return {_mm512_set1_ps(x)}; }
   static FloatLanes load(const float* p) { return {_mm512_load_ps(p)}; }
+  // Lane i is p[i * stride] for i < n (nothing beyond is read), `fill` in the others.
+  static FloatLanes gather(const float* p, int stride, int n, float fill) {
+    const __m512i index = _mm512_mullo_epi32(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15),
+                                             _mm512_set1_epi32(stride));
+    const auto in = static_cast<__mmask16>(n >= 16 ? 0xffffu : (1u << n) - 1u);
+    return {_mm512_mask_i32gather_ps(_mm512_set1_ps(fill), in, index, p, 4)};
+  }
   void storeu(float* p) const { _mm512_storeu_ps(p, v); }
   FloatLanes operator+(FloatLanes o) const { return {_mm512_add_ps(v, o.v)}; }
   FloatLanes operator-(FloatLanes o) const { return {_mm512_sub_ps(v, o.v)}; }
