@@ -77,6 +77,8 @@ namespace wide_packet_detail {
 using F = simd::FloatLanes<kPacketRays>;  // one ray per lane
 using F8 = simd::FloatLanes<8>;           // a node's 8 children
 
+using M = decltype(F::set1(0.0f) <= F::set1(0.0f));  // a lane mask: FloatLanes<8> (AVX2) or LaneMask16
+
 inline F nan_lanes() { return F::set1(std::numeric_limits<float>::quiet_NaN()); }
 
 // The packet's rays lane by lane as the single-ray tests read each (the box
@@ -88,7 +90,7 @@ inline F nan_lanes() { return F::set1(std::numeric_limits<float>::quiet_NaN()); 
 // the largest term). Lanes outside the plan hold their own ray or NaN.
 struct Packet {
   std::array<F, 3> org, dir;
-  F inv_dir[3], fused[3], tnear;
+  F inv_dir[3], fused[3], tnear, tfar;
   int near_offset[3];  // the shared octant's entry planes (RayLanes::near_offset)
   F8 inv_lo[3], inv_hi[3], fused_hi[3], fused_lo[3];
   F8 tnear_min, exit_max;
@@ -182,7 +184,8 @@ inline PacketPlan plan_packet(const Ray* rays, int n, float max_origin_distance,
     p.fused_lo[a] = F8::set1(fused_lo - pad);
   }
   p.tnear_min = F8::set1(simd::reduce_min(select(in, p.tnear, inf)));
-  const F exit_bound = min(field(7), F::set1(std::numeric_limits<float>::max()));  // box_exit_bound<SlabFma>
+  p.tfar = field(7);
+  const F exit_bound = min(p.tfar, F::set1(std::numeric_limits<float>::max()));  // box_exit_bound<SlabFma>
   p.exit_max = F8::set1(simd::reduce_max(select(in, exit_bound, F::set1(-kInf))));
   return plan;
 }
@@ -243,7 +246,6 @@ RAYBENCH_INLINE unsigned intersect_pack_rays(const Packet& p, F node_tnear, cons
   const auto dot = [](const std::array<F, 3>& a, const std::array<F, 3>& b) {  // MollerTrumboreNormal::dot_fma
     return fmadd(a[0], b[0], fmadd(a[1], b[1], a[2] * b[2]));
   };
-  using M = decltype(zero <= zero);  // a lane mask: FloatLanes<8> (AVX2) or LaneMask16
   // First every triangle's tests but the distance's bound (no branch: which
   // triangles pass for which rays is data, not control flow), then, in lane
   // order, only those that some ray passed.
@@ -315,16 +317,15 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
                   std::uint8_t* occluded) {
   using namespace wide_packet_detail;
   typename Leaf::RayData leaf_ray[kPacketRays];
-  alignas(64) float tmax[kPacketRays], outside[kPacketRays];
+  // Each ray's hit distance so far, 0 outside the plan; written as a vector
+  // where it is read as one (scalar stores could not be forwarded to the load).
+  alignas(64) float tmax[kPacketRays];
+  const M planned = M::from_bits(plan.lanes);
+  select(planned, p.tfar, F::set1(0.0f)).storeu(tmax);
   Hit hit[kPacketRays];
-  for (int i = 0; i < kPacketRays; ++i) {
-    const bool in = plan.lanes >> i & 1u;
-    tmax[i] = in ? rays[i].tfar : 0.0f;
-    outside[i] = in ? 0.0f : std::numeric_limits<float>::quiet_NaN();
-    if (in) {
-      if constexpr (!kRayLanesLeaf<Leaf>) leaf_ray[i] = Leaf::precompute(rays[i]);
-    }
-  }
+  if constexpr (!kRayLanesLeaf<Leaf>)
+    for (unsigned lanes = plan.lanes; lanes; lanes &= lanes - 1)
+      leaf_ray[std::countr_zero(lanes)] = Leaf::precompute(rays[std::countr_zero(lanes)]);
   constexpr float kLargest = std::numeric_limits<float>::max();
   // An occluded ray's tmax, so that it enters nothing more (any hit), and
   // the occluded rays.
@@ -332,14 +333,14 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
   unsigned done = 0;
   const auto mark_occluded = [&](unsigned lanes) {
     done |= lanes;
-    for (; lanes; lanes &= lanes - 1) tmax[std::countr_zero(lanes)] = kDone;
+    select(M::from_bits(lanes), F::set1(kDone), F::load(tmax)).storeu(tmax);
   };
   F reach = F::load(tmax);  // SlabFma is not conservative: a subtree is skipped when farther than tmax
   F exit = min(reach, F::set1(kLargest));
   PacketStack stack;
   std::uint32_t ref = 0;
   unsigned active = plan.lanes;
-  F node_tnear = p.tnear + F::load(outside);  // tnear in the lanes active at the node, NaN in the others
+  F node_tnear = select(planned, p.tnear, nan_lanes());  // tnear in the lanes active at the node, NaN in the others
   const auto update_bounds = [&] {
     reach = F::load(tmax);
     exit = min(reach, F::set1(kLargest));

@@ -70,6 +70,12 @@ struct FloatLanes<8> {
     const __m256 in = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(n), lane));
     return {_mm256_mask_i32gather_ps(_mm256_set1_ps(fill), p, _mm256_mullo_epi32(lane, _mm256_set1_epi32(stride)), in, 4)};
   }
+  // All bits set in lane i when bit i of `bits` is: a lane mask, as the comparisons give.
+  static FloatLanes from_bits(unsigned bits) {
+    const __m256i bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    const __m256i set = _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)), bit);
+    return {_mm256_castsi256_ps(_mm256_cmpeq_epi32(set, bit))};
+  }
   void storeu(float* p) const { _mm256_storeu_ps(p, v); }
   FloatLanes operator+(FloatLanes o) const { return {_mm256_add_ps(v, o.v)}; }
   FloatLanes operator-(FloatLanes o) const { return {_mm256_sub_ps(v, o.v)}; }
@@ -195,6 +201,7 @@ inline float reduce_max(FloatLanes<8> x) {
 // register), with the same ordered, non-signalling predicates as above.
 struct LaneMask16 {
   __mmask16 k;
+  static LaneMask16 from_bits(unsigned bits) { return {static_cast<__mmask16>(bits)}; }
   unsigned mask() const { return k; }
   LaneMask16 operator&(LaneMask16 o) const { return {static_cast<__mmask16>(k & o.k)}; }
 };
