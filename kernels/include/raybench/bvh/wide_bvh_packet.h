@@ -125,18 +125,16 @@ inline bool batch_looks_coherent(std::span<const Ray> rays, float max_origin_dis
   return false;
 }
 
-// Groups rays[0..n) (n <= kPacketRays) by the rule of the file's header,
-// all lanes at once, and sets up `p` for the packet. The first ray with a
-// finite origin and direction and no zero direction component leads.
-inline PacketPlan plan_packet(const Ray* rays, int n, float max_origin_distance, const BBox& extent, Packet& p) {
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  if (!looks_coherent(rays, n, max_origin_distance)) return {};
+// Reads rays[0..n) (n <= kPacketRays) into the lanes of `p` (NaN beyond
+// n); returns the rays a packet can take: a finite origin and direction and
+// no zero direction component.
+inline unsigned load_group(const Ray* rays, int n, Packet& p) {
   // Field k of a Ray's 8 floats (ox oy oz tnear dx dy dz tfar) of each ray, NaN beyond n.
   static_assert(sizeof(Ray) == 8 * sizeof(float));
   const auto field = [&](int k) {
     return F::gather(reinterpret_cast<const float*>(rays) + k, 8, n, std::numeric_limits<float>::quiet_NaN());
   };
-  const F inf = F::set1(kInf);
+  const F inf = F::set1(std::numeric_limits<float>::infinity());
   auto usable = F::set1(0.0f) <= F::set1(0.0f);  // every lane
   for (int a = 0; a < 3; ++a) {
     p.org[a] = field(a);
@@ -146,10 +144,22 @@ inline PacketPlan plan_packet(const Ray* rays, int n, float max_origin_distance,
     usable = usable & (p.org[a].abs() < inf) & (p.dir[a].abs() < inf) & (p.inv_dir[a].abs() < inf);
   }
   p.tnear = field(3);
-  const unsigned usable_rays = usable.mask();
-  if (usable_rays == 0) return {};
-  const int lead = std::countr_zero(usable_rays);
-  if (lead + kMinPacketRays > n) return {};
+  p.tfar = field(7);
+  return usable.mask();
+}
+
+// Among the rays `candidates` of a group loaded into `p` (load_group), the
+// packet led by the first: those that share its octant, point within
+// kMinPacketCosine of its direction and start within max_origin_distance
+// of its origin; sets up p's frustum for them. No packet (lanes 0) when
+// fewer than kMinPacketRays go together.
+inline PacketPlan plan_packet(const Ray* rays, unsigned candidates, float max_origin_distance, const BBox& extent,
+                              Packet& p) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const F inf = F::set1(kInf);
+  if (std::popcount(candidates) < kMinPacketRays) return {};
+  const M usable = M::from_bits(candidates);
+  const int lead = std::countr_zero(candidates);
   std::array<F, 3> lead_org, lead_dir;
   for (int a = 0; a < 3; ++a) {
     lead_org[a] = F::set1(rays[lead].org[a]);
@@ -184,7 +194,6 @@ inline PacketPlan plan_packet(const Ray* rays, int n, float max_origin_distance,
     p.fused_lo[a] = F8::set1(fused_lo - pad);
   }
   p.tnear_min = F8::set1(simd::reduce_min(select(in, p.tnear, inf)));
-  p.tfar = field(7);
   const F exit_bound = min(p.tfar, F::set1(std::numeric_limits<float>::max()));  // box_exit_bound<SlabFma>
   p.exit_max = F8::set1(simd::reduce_max(select(in, exit_bound, F::set1(-kInf))));
   return plan;
@@ -445,13 +454,42 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
 }
 #endif
 
+#if defined(__AVX2__)
+namespace wide_packet_detail {
+// Packets one group of rays may form: the first packet's lead is the group's
+// first usable ray, each further packet's the first ray left over.
+inline constexpr int kMaxPacketsPerGroup = 4;
+
+// Splits rays[0..n) (n <= kPacketRays) into packets, each traced by
+// in_packet(p, plan) as soon as it is planned (p is reused); stops at the
+// first lead with too few companions. Returns the rays left to go alone.
+template <typename InPacket>
+unsigned plan_group(const Ray* rays, int n, float max_origin_distance, const BBox& extent, Packet& p,
+                    InPacket&& in_packet) {
+  unsigned left = (1u << n) - 1u;
+  unsigned candidates = load_group(rays, n, p);
+  for (int k = 0; k < kMaxPacketsPerGroup; ++k) {
+    const PacketPlan plan = plan_packet(rays, candidates, max_origin_distance, extent, p);
+    if (!plan.lanes) break;
+    in_packet(p, plan);
+    left &= ~plan.lanes;
+    candidates &= ~plan.lanes;
+  }
+  return left;
+}
+}  // namespace wide_packet_detail
+#endif
+
 // The rays of rays[0..n) (n <= kPacketRays) that `intersect_packet_batch`
-// traces as one packet over a tree whose bounds are `extent` (bit i: ray
-// i); 0 where the traversal has no SIMD packets (without AVX2).
+// traces in packets over a tree whose bounds are `extent` (bit i: ray i),
+// in a batch that looks coherent; 0 where the traversal has no SIMD packets
+// (without AVX2).
 inline unsigned packet_lanes(const Ray* rays, int n, const BBox& extent) {
 #if defined(__AVX2__)
   wide_packet_detail::Packet p;
-  return plan_packet(rays, n, max_packet_origin_distance(extent), extent, p).lanes;
+  const unsigned left = wide_packet_detail::plan_group(rays, n, max_packet_origin_distance(extent), extent, p,
+                                                       [](const wide_packet_detail::Packet&, PacketPlan) {});
+  return ((1u << n) - 1u) & ~left;
 #else
   (void)rays, (void)n, (void)extent;
   return 0;
@@ -470,10 +508,9 @@ void trace_groups(const Bvh8& bvh, std::span<const Ray> rays, float max_origin_d
   for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
     const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
     Packet p;
-    const PacketPlan plan = plan_packet(&rays[first], n, max_origin_distance, bvh.bounds, p);
-    for (int i = 0; i < n; ++i)
-      if (!(plan.lanes >> i & 1u)) alone(first + static_cast<std::size_t>(i));
-    if (plan.lanes) in_packet(first, p, plan);
+    const unsigned left = plan_group(&rays[first], n, max_origin_distance, bvh.bounds, p,
+                                     [&](const Packet& packet, PacketPlan plan) { in_packet(first, packet, plan); });
+    for (unsigned lanes = left; lanes; lanes &= lanes - 1) alone(first + static_cast<std::size_t>(std::countr_zero(lanes)));
   }
 }
 
