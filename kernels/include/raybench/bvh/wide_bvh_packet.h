@@ -456,13 +456,14 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
 
 #if defined(__AVX2__)
 namespace wide_packet_detail {
-// Packets one group of rays may form: the first packet's lead is the group's
-// first usable ray, each further packet's the first ray left over.
+// Packets one group of rays may try to form: the first packet's lead is the
+// group's first usable ray, each further packet's the first ray left over.
 inline constexpr int kMaxPacketsPerGroup = 4;
 
 // Splits rays[0..n) (n <= kPacketRays) into packets, each traced by
-// in_packet(p, plan) as soon as it is planned (p is reused); stops at the
-// first lead with too few companions. Returns the rays left to go alone.
+// in_packet(p, plan) as soon as it is planned (p is reused); a lead with
+// too few companions goes alone and the next ray leads. At most
+// kMaxPacketsPerGroup tries. Returns the rays left to go alone.
 template <typename InPacket>
 unsigned plan_group(const Ray* rays, int n, float max_origin_distance, const BBox& extent, Packet& p,
                     InPacket&& in_packet) {
@@ -470,7 +471,10 @@ unsigned plan_group(const Ray* rays, int n, float max_origin_distance, const BBo
   unsigned candidates = load_group(rays, n, p);
   for (int k = 0; k < kMaxPacketsPerGroup; ++k) {
     const PacketPlan plan = plan_packet(rays, candidates, max_origin_distance, extent, p);
-    if (!plan.lanes) break;
+    if (!plan.lanes) {
+      candidates &= candidates - 1;  // the lead goes alone
+      continue;
+    }
     in_packet(p, plan);
     left &= ~plan.lanes;
     candidates &= ~plan.lanes;
