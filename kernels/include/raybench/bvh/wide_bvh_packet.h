@@ -32,6 +32,7 @@
 // docs/notes/kernels-packets.md
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -331,7 +332,18 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
   alignas(64) float tmax[kPacketRays];
   const M planned = M::from_bits(plan.lanes);
   select(planned, p.tfar, F::set1(0.0f)).storeu(tmax);
-  Hit hit[kPacketRays];
+  // Each ray's closest hit so far, field by field (its t is tmax): a Hit
+  // array written field by field and read whole stalled on every read.
+  std::int32_t hit_prim[kPacketRays];
+  float hit_u[kPacketRays], hit_v[kPacketRays];
+  std::fill_n(hit_prim, kPacketRays, kNoHit);
+  const auto set_hit = [&](int i, const Hit& h) {
+    tmax[i] = h.t;
+    hit_prim[i] = h.prim;
+    hit_u[i] = h.u;
+    hit_v[i] = h.v;
+  };
+  const auto hit_of = [&](int i) { return hit_prim[i] == kNoHit ? Hit{} : Hit{tmax[i], hit_prim[i], hit_u[i], hit_v[i]}; };
   if constexpr (!kRayLanesLeaf<Leaf>)
     for (unsigned lanes = plan.lanes; lanes; lanes &= lanes - 1)
       leaf_ray[std::countr_zero(lanes)] = Leaf::precompute(rays[std::countr_zero(lanes)]);
@@ -362,8 +374,8 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
         if constexpr (AnyHit) {
           if (traverse_wide_from<true, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, Hit{})) mark_occluded(1u << i);
         } else {
-          hit[i] = traverse_wide_from<false, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, hit[i]);
-          if (hit[i].hit()) tmax[i] = hit[i].t;
+          const Hit h = traverse_wide_from<false, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, hit_of(i));
+          if (h.hit()) set_hit(i, h);
         }
       }
       update_bounds();
@@ -387,7 +399,7 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
             v.storeu(vs);
             for (unsigned lanes = hit_rays; lanes; lanes &= lanes - 1) {
               const int i = std::countr_zero(lanes);
-              hit[i] = pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane_of[i], tmax[i], us[i], vs[i]);
+              set_hit(i, pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane_of[i], tmax[i], us[i], vs[i]));
             }
           }
           update_bounds();
@@ -403,8 +415,7 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
           if constexpr (AnyHit) {
             mark_occluded(1u << i);
           } else {
-            tmax[i] = th.t;
-            hit[i] = pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane, th.t, th.u, th.v);
+            set_hit(i, pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane, th.t, th.u, th.v));
           }
         }
         if (any) update_bounds();
@@ -437,7 +448,7 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
         for (unsigned lanes = plan.lanes; lanes; lanes &= lanes - 1) {
           const int i = std::countr_zero(lanes);
           if constexpr (AnyHit) occluded[i] = done >> i & 1u;
-          else hits[i] = hit[i];
+          else hits[i] = hit_of(i);
         }
         return;
       }
