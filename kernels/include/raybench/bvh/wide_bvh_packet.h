@@ -308,10 +308,12 @@ RAYBENCH_INLINE unsigned intersect_pack_rays(const Packet& p, F node_tnear, cons
 }
 
 // The traversal stack: a subtree and each ray's entry distance into it (NaN
-// for the rays that do not enter it).
+// for the rays that do not enter it), or for any hit, whose interval never
+// shrinks, only the rays that enter it (bit i: ray i).
 struct PacketStack {
   static constexpr std::size_t kSize = 8 * wide_bvh_detail::kMaxDepth + 8;
   alignas(64) float entry[kSize][kPacketRays];
+  std::uint32_t lanes[kSize];
   std::uint32_t ref[kSize];
   int top = 0;
 };
@@ -423,13 +425,16 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
     } else {
       const WideNode<8>& node = bvh.nodes[ref];
       F child_entry[8];
+      unsigned child_rays[8];
       unsigned entered = 0;
       for (unsigned lanes = frustum_children(p, node); lanes; lanes &= lanes - 1) {
         const int lane = std::countr_zero(lanes);
-        if (child_hits(p, node, lane, node_tnear, exit, child_entry[lane])) entered |= 1u << lane;
+        child_rays[lane] = child_hits(p, node, lane, node_tnear, exit, child_entry[lane]);
+        if (child_rays[lane]) entered |= 1u << lane;
       }
       const auto push = [&](int lane) {
-        child_entry[lane].storeu(stack.entry[stack.top]);
+        if constexpr (AnyHit) stack.lanes[stack.top] = child_rays[lane];
+        else child_entry[lane].storeu(stack.entry[stack.top]);
         stack.ref[stack.top] = node.child[lane];
         ++stack.top;
       };
@@ -453,12 +458,21 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
         return;
       }
       --stack.top;
-      const auto within = F::load(stack.entry[stack.top]) <= reach;
-      active = within.mask();
-      if (active) {
-        ref = stack.ref[stack.top];
-        node_tnear = select(within, p.tnear, nan_lanes());
-        break;
+      if constexpr (AnyHit) {
+        active = stack.lanes[stack.top] & ~done;
+        if (active) {
+          ref = stack.ref[stack.top];
+          node_tnear = select(M::from_bits(active), p.tnear, nan_lanes());
+          break;
+        }
+      } else {
+        const auto within = F::load(stack.entry[stack.top]) <= reach;
+        active = within.mask();
+        if (active) {
+          ref = stack.ref[stack.top];
+          node_tnear = select(within, p.tnear, nan_lanes());
+          break;
+        }
       }
     }
   }
