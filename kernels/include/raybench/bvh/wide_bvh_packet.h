@@ -18,14 +18,15 @@
 // leaves ray by ray. A subtree left with kAloneAtMost active rays is traced
 // by each alone (traverse_wide_from), as Embree's hybrid traversal turns to
 // single rays (bvh_intersector_hybrid.cpp).
-// Grouping: consecutive rays form a packet of those that share the first
-// usable ray's octant (finite, no zero direction component: SlabFma's
-// rays), point within kMinPacketCosine of its direction and start within
-// kMaxPacketOriginSpread of its origin; the others, and a group with fewer
-// than kMinPacketRays such rays, are traced alone. A scalar glance at two
-// rays turns incoherent groups away first, and a batch whose first groups
-// all look incoherent (diffuse, uniform rays) is traced by the single-ray
-// batch loop itself (wide_bvh_batch.h).
+// Grouping: a group of kPacketRays consecutive rays forms a packet of those
+// that share the first usable ray's octant (finite, no zero direction
+// component: SlabFma's rays), point within kMinPacketCosine of its
+// direction and start within kMaxPacketOriginSpread of its origin, then
+// another led by the first ray left, up to kMaxPacketsPerGroup tries (a
+// tile across an octant boundary or a depth edge); a packet needs
+// kMinPacketRays, the rays left are traced alone. A batch whose first groups
+// all fail a scalar glance at two of their rays (diffuse, uniform rays) is
+// traced by the single-ray batch loop itself (wide_bvh_batch.h).
 // Guarantee: every ray's answer is traverse_wide's with SlabFma, the Hit bit
 // for bit and the occlusion bit, whatever the grouping (tested:
 // kernels/tests/wide_bvh_packet_test.cpp). Design and measurements:
