@@ -54,9 +54,10 @@ inline constexpr int kPacketRays = 8;
 #endif
 inline constexpr int kMinPacketRays = 3;
 // Active rays in a subtree that go on alone: 3 of 16 (measured: 1 of 16 was
-// 8-15 % slower on the terrain's tiled rays, the same on Sponza's), the same
-// share of 8.
-inline constexpr int kAloneAtMost = kPacketRays == 16 ? 3 : 1;
+// 8-15 % slower on the terrain's tiled rays, the same on Sponza's), 2 of 8
+// (measured with AVX-512 disabled: 1 of 8 was 2 % slower on tiled shadow
+// rays, 3 of 8 1.5 % on tiled primary rays).
+inline constexpr int kAloneAtMost = kPacketRays == 16 ? 3 : 2;
 // How alike a packet's rays must be. Measured on Sponza, Conference, the
 // terrain and the bunny (docs/notes/kernels-packets.md): from 0.99 and 2 %,
 // these made tiled shadow rays 2-18 % faster and left the others as fast;
