@@ -101,8 +101,8 @@ struct Packet {
 
 // A glance at a group of rays[0..n) (n <= kPacketRays), in scalar code: the
 // middle and the last ray go with the first (same octant, within the
-// cosine and the origin distance). A group where either does not is taken
-// for incoherent (diffuse, uniform rays) and costs no more than this.
+// cosine and the origin distance). batch_looks_coherent samples a batch's
+// first groups with it; a group where either does not looks incoherent.
 inline bool looks_coherent(const Ray* rays, int n, float max_origin_distance) {
   const auto together = [&](const Ray& a, const Ray& b) {
     const float cosine = dot(a.dir, b.dir);
@@ -548,9 +548,8 @@ void trace_groups(const Bvh8& bvh, std::span<const Ray> rays, float max_origin_d
 }  // namespace wide_packet_detail
 #endif
 
-
 // Closest hit of every ray, consecutive coherent rays traced as packets
-// (plan_packet), the others alone, and a batch whose first groups all look
+// (plan_group), the others alone, and a batch whose first groups all look
 // incoherent (or any batch without AVX2) by intersect_wide_batch itself:
 // the same Hit for every ray as intersect_wide_batch. Screened rays, as
 // wide_bvh_batch.h's loops.
