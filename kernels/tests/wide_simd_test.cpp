@@ -165,6 +165,29 @@ TEST(Watertight8, Avx2AnswersExactlyAsTheScalarWoopTestEvenThroughEdgesAndVertic
         return intersect8_watertight_scalar(WatertightTriangle::precompute(c.ray), c.tmax, p, h);
       });
 }
+
+// Any hit asks only for some lane that hits: the test returns one exactly
+// when the closest-hit test returns a lane, and that lane hits on its own.
+TEST(Watertight8, AnyLaneAnswersALaneThatHitsExactlyWhenTheClosestTestHits) {
+  std::mt19937 rng(5);
+  int hits = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const RandomPack c = random_pack(rng, i, true, 8);
+    const TriangleVertices8 packed = TriangleVertices8::pack(c.tris);
+    const WatertightTriangle::RayData ray = WatertightTriangle::precompute(c.ray);
+    TriangleHit closest{}, unused{};
+    const bool hit = intersect8_watertight_simd(ray, c.tmax, packed, closest) >= 0;
+    for (const int any : {intersect8_watertight_simd<true>(ray, c.tmax, packed, unused),
+                          intersect8_watertight_scalar<true>(ray, c.tmax, packed, unused)}) {
+      ASSERT_EQ(any >= 0, hit) << "ray " << i;
+      if (any < 0) continue;
+      TriangleHit own{};
+      EXPECT_TRUE(WatertightTriangle::intersect(ray, c.tmax, packed.lane(any), own)) << "ray " << i;
+    }
+    hits += hit;
+  }
+  EXPECT_GT(hits, 5000);
+}
 #endif
 
 TEST(Watertight8, NoRayFromInsideAClosedMeshSlipsBetweenPacks) {

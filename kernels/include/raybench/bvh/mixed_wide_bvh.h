@@ -78,7 +78,8 @@ struct MixedWideBvh : WideBvh<W> {
 // The leaf test of a MixedWideBvh: TriangleLeaf's pack test (WideMollerTrumbore,
 // WideMollerTrumboreEdges, Bvh8Watertight) on the pack's triangle lanes, then
 // each analytic lane; returns the lane of the closest hit in (tnear, tmax]
-// (on equal t the last tested), or -1. Only for trees built by
+// (on equal t the last tested), or -1; with AnyLane, a lane that hits (any
+// hit), `out` then unset. Only for trees built by
 // build_mixed_wide_bvh: it reads the MixedWideBvh behind the WideBvh.
 template <typename TriangleLeaf>
 struct MixedWideLeaf {
@@ -93,20 +94,25 @@ struct MixedWideLeaf {
     return {TriangleLeaf::precompute(ray), AnalyticRay::precompute(ray)};
   }
 
-  template <int W>
+  template <bool AnyLane = false, int W>
   RAYBENCH_INLINE static int intersect(const RayData& ray, float tmax, const WideBvh<W>& bvh, std::uint32_t pack,
                                        TriangleHit& out) {
     const auto& m = static_cast<const MixedWideBvh<W>&>(bvh);
-    if (pack < m.first_mixed_pack) return TriangleLeaf::intersect(ray.triangle, tmax, bvh, pack, out);
+    if (pack < m.first_mixed_pack) return TriangleLeaf::template intersect<AnyLane>(ray.triangle, tmax, bvh, pack, out);
     const MixedPack p = m.mixed_packs[pack - m.first_mixed_pack];
     int lane = -1;
     if (p.lane != 0) {
-      lane = TriangleLeaf::intersect(ray.triangle, tmax, bvh, pack, out);
-      if (lane >= 0) tmax = out.t;
+      lane = TriangleLeaf::template intersect<AnyLane>(ray.triangle, tmax, bvh, pack, out);
+      if constexpr (AnyLane) {
+        if (lane >= 0) return lane;
+      } else if (lane >= 0) {
+        tmax = out.t;
+      }
     }
     for (int k = 0; k < p.count; ++k) {
       float t;
       if (m.analytic.intersect(ray.analytic, tmax, m.analytic_refs[p.first + k], t)) {
+        if constexpr (AnyLane) return p.lane + k;
         tmax = t;
         out = {t, 0.0f, 0.0f};
         lane = p.lane + k;

@@ -413,7 +413,7 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
         for (unsigned lanes = active; lanes; lanes &= lanes - 1) {
           const int i = std::countr_zero(lanes);
           TriangleHit th{};
-          const int lane = Leaf::intersect(leaf_ray[i], tmax[i], bvh, pack, th);
+          const int lane = Leaf::template intersect<AnyHit>(leaf_ray[i], tmax[i], bvh, pack, th);
           if (lane < 0) continue;
           any = true;
           if constexpr (AnyHit) {

@@ -57,7 +57,9 @@ struct alignas(64) TriangleVertices8 {
 
 // Lane by lane with the scalar test, every lane against the same tmax.
 // Returns the lane of the closest hit in (tnear, tmax], or -1; on equal t the
-// last such lane wins (as intersect_pack).
+// last such lane wins (as intersect_pack). With AnyLane, the first lane that
+// hits, without looking for the closest; `out` is then unset (as intersect_pack).
+template <bool AnyLane = false>
 inline int intersect8_watertight_scalar(const WatertightTriangle::RayData& ray, float tmax, const TriangleVertices8& t,
                                         TriangleHit& out) {
   int best = -1;
@@ -65,6 +67,7 @@ inline int intersect8_watertight_scalar(const WatertightTriangle::RayData& ray, 
   for (int lane = 0; lane < 8; ++lane) {
     TriangleHit h{};
     if (WatertightTriangle::intersect(ray, tmax, t.lane(lane), h) && (best < 0 || h.t <= best_t)) {
+      if constexpr (AnyLane) return lane;
       out = h;
       best_t = h.t;
       best = lane;
@@ -74,6 +77,7 @@ inline int intersect8_watertight_scalar(const WatertightTriangle::RayData& ray, 
 }
 
 #if defined(__AVX2__)
+template <bool AnyLane = false>
 RAYBENCH_INLINE int intersect8_watertight_simd(const WatertightTriangle::RayData& r, float tmax, const TriangleVertices8& t,
                                       TriangleHit& out) {
   // Axis kx of vertex k lies at px + kVertex * k: one base per axis and
@@ -144,6 +148,8 @@ RAYBENCH_INLINE int intersect8_watertight_simd(const WatertightTriangle::RayData
   int mask = _mm256_movemask_ps(ok);
 #endif
   if (!mask && !exact) return -1;
+  if constexpr (AnyLane)
+    if (mask) return __builtin_ctz(static_cast<unsigned>(mask));  // a lane strictly inside hits
   // The barycentrics are divided for the closest lane only.
   alignas(32) float ts[8], vs[8], ws[8], dets[8];
   _mm256_store_ps(ts, tt);
@@ -155,6 +161,7 @@ RAYBENCH_INLINE int intersect8_watertight_simd(const WatertightTriangle::RayData
   for (int lanes = exact; lanes; lanes &= lanes - 1) {
     const int lane = __builtin_ctz(static_cast<unsigned>(lanes));
     if (WatertightTriangle::intersect(r, tmax, t.lane(lane), exact_hit[lane])) {
+      if constexpr (AnyLane) return lane;
       ts[lane] = exact_hit[lane].t;
       mask |= 1 << lane, exact_hits |= 1 << lane;
     }
@@ -175,12 +182,13 @@ RAYBENCH_INLINE int intersect8_watertight_simd(const WatertightTriangle::RayData
 }
 #endif
 
+template <bool AnyLane = false>
 RAYBENCH_INLINE int intersect8_watertight(const WatertightTriangle::RayData& ray, float tmax, const TriangleVertices8& t,
                                  TriangleHit& out) {
 #if defined(__AVX2__)
-  return intersect8_watertight_simd(ray, tmax, t, out);
+  return intersect8_watertight_simd<AnyLane>(ray, tmax, t, out);
 #else
-  return intersect8_watertight_scalar(ray, tmax, t, out);
+  return intersect8_watertight_scalar<AnyLane>(ray, tmax, t, out);
 #endif
 }
 
