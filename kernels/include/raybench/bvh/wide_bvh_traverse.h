@@ -238,10 +238,11 @@ RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide_from(const W
     if (ref & WideBvh<W>::kLeafBit) {
       const std::uint32_t pack = ref & ~WideBvh<W>::kLeafBit;
       TriangleHit th{};  // set when a lane hits (initialised: the scalar fallback sets it conditionally)
-      // Any hit: a lane hit, which is the whole answer; the leaf test does
-      // not look for the closest lane, and its triangle is not looked up in
-      // pack_prims, an array the traversal never reads otherwise, which the
-      // answer waited for (measured: docs/notes/kernels-wide-traversal.md).
+      // Any hit: a lane hit, which is the whole answer. The leaf test need
+      // not find the closest lane (the watertight one stops at its first),
+      // and the triangle is not looked up in pack_prims, an array the
+      // traversal never reads otherwise, which the answer waited for
+      // (measured: docs/notes/kernels-wide-traversal.md).
       const int lane = Leaf::template intersect<AnyHit>(leaf_ray, tmax, bvh, pack, th);
       if constexpr (AnyHit) {
         if (lane >= 0) return true;
