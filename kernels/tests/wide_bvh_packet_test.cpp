@@ -85,9 +85,22 @@ std::vector<Ray> shadow_rays(const Bvh8& bvh, const std::vector<Ray>& primary, V
   return rays;
 }
 
+// The rays of `primary` cut short just before their closest hit: they enter
+// the leaf that holds it, whose triangle lies beyond their tfar, so they
+// miss it (and occlude nothing there).
+template <typename Leaf>
+std::vector<Ray> cut_short(const Bvh8& bvh, std::vector<Ray> primary) {
+  std::vector<Hit> hits(primary.size());
+  intersect_wide_batch<Leaf, SlabFma>(bvh, primary, hits);
+  for (std::size_t i = 0; i < primary.size(); ++i)
+    if (hits[i].hit()) primary[i].tfar = hits[i].t * 0.9999f;
+  return primary;
+}
+
 // Every kind of ray the traversals must agree on, coherent and not, with
 // odd rays planted inside packets: NaN, infinite and zero directions, a NaN
-// origin, an empty interval, a tnear beyond the mesh.
+// origin, an empty interval, a tnear beyond the mesh; and coherent rays
+// that end just before their first surface.
 template <typename Leaf>
 std::vector<Ray> every_ray(const Bvh8& bvh, const std::vector<Triangle>& tris) {
   std::vector<Ray> rays = camera_rays({0.5f, 0.3f, 9.0f}, 64, 48);
@@ -95,6 +108,8 @@ std::vector<Ray> every_ray(const Bvh8& bvh, const std::vector<Triangle>& tris) {
   rays.insert(rays.end(), inside.begin(), inside.end());
   const std::vector<Ray> shadow = shadow_rays<Leaf>(bvh, camera_rays({0.5f, 0.3f, 9.0f}, 64, 48), {3.0f, 6.0f, 4.0f});
   rays.insert(rays.end(), shadow.begin(), shadow.end());
+  const std::vector<Ray> short_of_hits = cut_short<Leaf>(bvh, camera_rays({0.5f, 0.3f, 9.0f}, 64, 48));
+  rays.insert(rays.end(), short_of_hits.begin(), short_of_hits.end());
   for (std::string_view kind : testing::kRayKinds) {
     const std::vector<Ray> more = testing::rays_at(tris, kind, 2000, 7);
     rays.insert(rays.end(), more.begin(), more.end());

@@ -188,7 +188,7 @@ inline PacketPlan plan_packet(const Ray* rays, unsigned candidates, float max_or
     const float inv_hi = simd::reduce_max(select(in, p.inv_dir[a], F::set1(-kInf)));
     const float fused_lo = simd::reduce_min(select(in, p.fused[a], inf));
     const float fused_hi = simd::reduce_max(select(in, p.fused[a], F::set1(-kInf)));
-    const float fused_abs = simd::reduce_max(select(in, p.fused[a].abs(), zero));
+    const float fused_abs = std::max(std::fabs(fused_lo), std::fabs(fused_hi));  // the largest |o/d|
     const float plane_abs = std::max(std::fabs(extent.lower[a]), std::fabs(extent.upper[a]));
     const float pad = 0x1p-20f * (plane_abs * std::max(std::fabs(inv_lo), std::fabs(inv_hi)) + fused_abs);
     p.inv_lo[a] = F8::set1(inv_lo);
@@ -250,8 +250,9 @@ inline constexpr bool kRayLanesLeaf =
 // hit when at or before it (tmax inclusive): the pack test's answer, the
 // closest lane and the last of equal ones. `node_tnear` is NaN in the
 // inactive lanes (they fail every comparison). Updates tmax, u, v and
-// `lane_of` (the pack lane) of the rays it hit; returns them.
-template <typename Pack>
+// `lane_of` (the pack lane) of the rays it hit; returns them. AnyHit: only
+// which rays some triangle hits within (node_tnear, tmax], no u, v, lane.
+template <bool AnyHit, typename Pack>
 RAYBENCH_INLINE unsigned intersect_pack_rays(const Packet& p, F node_tnear, const Pack& t, F& tmax, F& u, F& v,
                                              int* lane_of) {
   const F zero = F::set1(0.0f);
@@ -289,8 +290,10 @@ RAYBENCH_INLINE unsigned intersect_pack_rays(const Packet& p, F node_tnear, cons
     candidates |= static_cast<unsigned>(ok_of[j].mask() != 0) << j;
     t_scaled.storeu(t_scaled_of[j]);
     abs_det.storeu(abs_det_of[j]);
-    u_scaled.storeu(u_scaled_of[j]);
-    v_scaled.storeu(v_scaled_of[j]);
+    if constexpr (!AnyHit) {
+      u_scaled.storeu(u_scaled_of[j]);
+      v_scaled.storeu(v_scaled_of[j]);
+    }
   }
   unsigned hit_rays = 0;
   for (; candidates; candidates &= candidates - 1) {
@@ -299,6 +302,10 @@ RAYBENCH_INLINE unsigned intersect_pack_rays(const Packet& p, F node_tnear, cons
     const F tt = F::load(t_scaled_of[j]) * inv_det;
     const auto accept = ok_of[j] & (tt > node_tnear) & (tt <= tmax);
     unsigned rays = accept.mask();
+    if constexpr (AnyHit) {
+      hit_rays |= rays;
+      continue;
+    }
     if (!rays) continue;
     tmax = select(accept, tt, tmax);
     u = select(accept, F::load(u_scaled_of[j]) * inv_det, u);
@@ -390,9 +397,9 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
         alignas(64) int lane_of[kPacketRays];
         unsigned hit_rays;
         if constexpr (Leaf::kLeaves == WideLeaves::kMollerTrumbore)
-          hit_rays = intersect_pack_rays(p, node_tnear, bvh.packs[pack], best_t, u, v, lane_of);
+          hit_rays = intersect_pack_rays<AnyHit>(p, node_tnear, bvh.packs[pack], best_t, u, v, lane_of);
         else
-          hit_rays = intersect_pack_rays(p, node_tnear, bvh.edge_packs[pack], best_t, u, v, lane_of);
+          hit_rays = intersect_pack_rays<AnyHit>(p, node_tnear, bvh.edge_packs[pack], best_t, u, v, lane_of);
         if (hit_rays) {
           if constexpr (AnyHit) {
             mark_occluded(hit_rays);
@@ -496,7 +503,7 @@ unsigned plan_group(const Ray* rays, int n, float max_origin_distance, const BBo
                     InPacket&& in_packet) {
   unsigned left = (1u << n) - 1u;
   unsigned candidates = load_group(rays, n, p);
-  for (int k = 0; k < kMaxPacketsPerGroup; ++k) {
+  for (int k = 0; k < kMaxPacketsPerGroup && std::popcount(candidates) >= kMinPacketRays; ++k) {
     const PacketPlan plan = plan_packet(rays, candidates, max_origin_distance, extent, p);
     if (!plan.lanes) {
       candidates &= candidates - 1;  // the lead goes alone
