@@ -103,12 +103,13 @@ std::vector<Ray> cut_short(const Bvh8& bvh, std::vector<Ray> primary) {
 // that end just before their first surface.
 template <typename Leaf>
 std::vector<Ray> every_ray(const Bvh8& bvh, const std::vector<Triangle>& tris) {
-  std::vector<Ray> rays = camera_rays({0.5f, 0.3f, 9.0f}, 64, 48);
+  const std::vector<Ray> camera = camera_rays({0.5f, 0.3f, 9.0f}, 64, 48);
+  std::vector<Ray> rays = camera;
   const std::vector<Ray> inside = camera_rays({0.1f, 0.05f, 0.2f}, 32, 16);  // inside the unit sphere
   rays.insert(rays.end(), inside.begin(), inside.end());
-  const std::vector<Ray> shadow = shadow_rays<Leaf>(bvh, camera_rays({0.5f, 0.3f, 9.0f}, 64, 48), {3.0f, 6.0f, 4.0f});
+  const std::vector<Ray> shadow = shadow_rays<Leaf>(bvh, camera, {3.0f, 6.0f, 4.0f});
   rays.insert(rays.end(), shadow.begin(), shadow.end());
-  const std::vector<Ray> short_of_hits = cut_short<Leaf>(bvh, camera_rays({0.5f, 0.3f, 9.0f}, 64, 48));
+  const std::vector<Ray> short_of_hits = cut_short<Leaf>(bvh, camera);
   rays.insert(rays.end(), short_of_hits.begin(), short_of_hits.end());
   for (std::string_view kind : testing::kRayKinds) {
     const std::vector<Ray> more = testing::rays_at(tris, kind, 2000, 7);

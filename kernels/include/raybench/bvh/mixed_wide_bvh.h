@@ -79,7 +79,7 @@ struct MixedWideBvh : WideBvh<W> {
 // WideMollerTrumboreEdges, Bvh8Watertight) on the pack's triangle lanes, then
 // each analytic lane; returns the lane of the closest hit in (tnear, tmax]
 // (on equal t the last tested), or -1; with AnyLane, a lane that hits (any
-// hit), `out` then unset. Only for trees built by
+// hit), `out` then not necessarily set. Only for trees built by
 // build_mixed_wide_bvh: it reads the MixedWideBvh behind the WideBvh.
 template <typename TriangleLeaf>
 struct MixedWideLeaf {

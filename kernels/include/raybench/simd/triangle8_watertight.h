@@ -58,7 +58,7 @@ struct alignas(64) TriangleVertices8 {
 // Lane by lane with the scalar test, every lane against the same tmax.
 // Returns the lane of the closest hit in (tnear, tmax], or -1; on equal t the
 // last such lane wins (as intersect_pack). With AnyLane, the first lane that
-// hits, without looking for the closest; `out` is then unset (as intersect_pack).
+// hits, without looking for the closest; `out` is then not necessarily set.
 template <bool AnyLane = false>
 inline int intersect8_watertight_scalar(const WatertightTriangle::RayData& ray, float tmax, const TriangleVertices8& t,
                                         TriangleHit& out) {
