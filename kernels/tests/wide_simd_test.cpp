@@ -1,6 +1,8 @@
 // Specification of the 8-wide batched tests (raybench/simd/): on every input,
 // the AVX2 form answers exactly as the scalar kernels, lane by lane.
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <vector>
@@ -224,6 +226,30 @@ TEST(Box8, EmptyLanesAreMissed) {
   EXPECT_EQ(intersect_boxes(r, kInf, BBox8::pack(one), entry), 1u);
   EXPECT_FLOAT_EQ(entry[0], 1.0f);
 }
+
+#if defined(__AVX2__)
+// load_transposed8 of W rows of 8 floats: lane i of field k is row i's element k, bit for bit
+// (signed zeros and NaN payloads included), for every one of the W x 8 positions.
+template <int W>
+void expect_rows_transposed() {
+  alignas(64) float rows[W * 8];
+  for (int i = 0; i < W * 8; ++i) rows[i] = static_cast<float>(i) + 0.5f;
+  rows[3] = -0.0f;
+  rows[W * 8 - 1] = std::bit_cast<float>(0x7fc01234u);  // a NaN with a payload
+  simd::FloatLanes<W> fields[8];
+  simd::FloatLanes<W>::load_transposed8(rows, fields);
+  for (int k = 0; k < 8; ++k) {
+    alignas(64) float lanes[W];
+    fields[k].storeu(lanes);
+    for (int i = 0; i < W; ++i)
+      EXPECT_EQ(std::bit_cast<std::uint32_t>(lanes[i]), std::bit_cast<std::uint32_t>(rows[i * 8 + k])) << "field " << k << " lane " << i;
+  }
+}
+TEST(FloatLanes, EightRowsLoadTransposedIntoEightLanesPerField) { expect_rows_transposed<8>(); }
+#if defined(RAYBENCH_AVX512)
+TEST(FloatLanes, SixteenRowsLoadTransposedIntoSixteenLanesPerField) { expect_rows_transposed<16>(); }
+#endif
+#endif
 
 }  // namespace
 }  // namespace raybench

@@ -132,11 +132,20 @@ inline bool batch_looks_coherent(std::span<const Ray> rays, float max_origin_dis
 // n); returns the rays a packet can take: a finite origin and direction and
 // no zero direction component.
 inline unsigned load_group(const Ray* rays, int n, Packet& p) {
-  // Field k of a Ray's 8 floats (ox oy oz tnear dx dy dz tfar) of each ray, NaN beyond n.
+  // fields[k]: field k of a Ray's 8 floats (ox oy oz tnear dx dy dz tfar) of each ray, NaN beyond n: the rays
+  // transposed from row loads (not gathered: docs/notes/kernels-packets.md), a short group's through a copy
+  // padded with NaN rays.
   static_assert(sizeof(Ray) == 8 * sizeof(float));
-  const auto field = [&](int k) {
-    return F::gather(reinterpret_cast<const float*>(rays) + k, 8, n, std::numeric_limits<float>::quiet_NaN());
-  };
+  F fields[8];
+  if (n == kPacketRays) {
+    F::load_transposed8(reinterpret_cast<const float*>(rays), fields);
+  } else {
+    alignas(64) std::array<float, 8 * kPacketRays> padded;
+    padded.fill(std::numeric_limits<float>::quiet_NaN());
+    std::copy_n(reinterpret_cast<const float*>(rays), 8 * n, padded.data());
+    F::load_transposed8(padded.data(), fields);
+  }
+  const auto field = [&](int k) { return fields[k]; };
   const F inf = F::set1(std::numeric_limits<float>::infinity());
   auto usable = F::set1(0.0f) <= F::set1(0.0f);  // every lane
   for (int a = 0; a < 3; ++a) {

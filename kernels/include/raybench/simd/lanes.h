@@ -64,12 +64,9 @@ struct FloatLanes<8> {
   __m256 v;
   static FloatLanes set1(float x) { return {_mm256_set1_ps(x)}; }
   static FloatLanes load(const float* p) { return {_mm256_load_ps(p)}; }
-  // Lane i is p[i * stride] for i < n (nothing beyond is read), `fill` in the others.
-  static FloatLanes gather(const float* p, int stride, int n, float fill) {
-    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    const __m256 in = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(n), lane));
-    return {_mm256_mask_i32gather_ps(_mm256_set1_ps(fill), p, _mm256_mullo_epi32(lane, _mm256_set1_epi32(stride)), in, 4)};
-  }
+  // The 8 rows of 8 floats at `rows` transposed: lane i of out[k] is rows[i * 8 + k].
+  // Row loads and in-register shuffles (transpose4_in_lanes below), no gather.
+  static void load_transposed8(const float* rows, FloatLanes (&out)[8]);
   // All bits set in lane i when bit i of `bits` is: a lane mask, as the comparisons give.
   static FloatLanes from_bits(unsigned bits) {
     const __m256i bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
@@ -195,6 +192,33 @@ inline float reduce_max(FloatLanes<8> x) {
   return _mm_cvtss_f32(_mm_max_ss(a, _mm_movehdup_ps(a)));
 }
 
+// The first two steps of the 8 x 8 transpose (the classic unpack and
+// shuffle): from rows r[0..4), tt[k]'s low 128 bits hold element k of the
+// four rows and its high 128 bits element k + 4 (each half of a wider
+// register alike, for the 16-lane form below).
+template <class V, class Unpacklo, class Unpackhi, class Shuffle>
+inline void transpose4_in_lanes(const V (&r)[4], V (&tt)[4], Unpacklo unpacklo, Unpackhi unpackhi, Shuffle shuffle) {
+  const V t0 = unpacklo(r[0], r[1]), t1 = unpackhi(r[0], r[1]), t2 = unpacklo(r[2], r[3]), t3 = unpackhi(r[2], r[3]);
+  tt[0] = shuffle.template operator()<_MM_SHUFFLE(1, 0, 1, 0)>(t0, t2);
+  tt[1] = shuffle.template operator()<_MM_SHUFFLE(3, 2, 3, 2)>(t0, t2);
+  tt[2] = shuffle.template operator()<_MM_SHUFFLE(1, 0, 1, 0)>(t1, t3);
+  tt[3] = shuffle.template operator()<_MM_SHUFFLE(3, 2, 3, 2)>(t1, t3);
+}
+
+inline void FloatLanes<8>::load_transposed8(const float* rows, FloatLanes (&out)[8]) {
+  const auto unpacklo = [](__m256 a, __m256 b) { return _mm256_unpacklo_ps(a, b); };
+  const auto unpackhi = [](__m256 a, __m256 b) { return _mm256_unpackhi_ps(a, b); };
+  const auto shuffle = []<int Imm>(__m256 a, __m256 b) { return _mm256_shuffle_ps(a, b, Imm); };
+  __m256 lo[4], hi[4], tlo[4], thi[4];  // rows 0-3 and 4-7
+  for (int i = 0; i < 4; ++i) lo[i] = _mm256_loadu_ps(rows + 8 * i), hi[i] = _mm256_loadu_ps(rows + 8 * (i + 4));
+  transpose4_in_lanes(lo, tlo, unpacklo, unpackhi, shuffle);
+  transpose4_in_lanes(hi, thi, unpacklo, unpackhi, shuffle);
+  for (int k = 0; k < 4; ++k) {
+    out[k] = {_mm256_permute2f128_ps(tlo[k], thi[k], 0x20)};
+    out[k + 4] = {_mm256_permute2f128_ps(tlo[k], thi[k], 0x31)};
+  }
+}
+
 #if defined(RAYBENCH_AVX512)
 // 16 float lanes in one AVX-512 register, for the packet traversal's 16
 // rays (bvh/wide_bvh_packet.h). Comparisons give a LaneMask16 (a mask
@@ -211,13 +235,8 @@ struct FloatLanes<16> {
   __m512 v;
   static FloatLanes set1(float x) { return {_mm512_set1_ps(x)}; }
   static FloatLanes load(const float* p) { return {_mm512_load_ps(p)}; }
-  // Lane i is p[i * stride] for i < n (nothing beyond is read), `fill` in the others.
-  static FloatLanes gather(const float* p, int stride, int n, float fill) {
-    const __m512i index = _mm512_mullo_epi32(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15),
-                                             _mm512_set1_epi32(stride));
-    const auto in = static_cast<__mmask16>(n >= 16 ? 0xffffu : (1u << n) - 1u);
-    return {_mm512_mask_i32gather_ps(_mm512_set1_ps(fill), in, index, p, 4)};
-  }
+  // The 16 rows of 8 floats at `rows` transposed: lane i of out[k] is rows[i * 8 + k].
+  static void load_transposed8(const float* rows, FloatLanes (&out)[8]);
   void storeu(float* p) const { _mm512_storeu_ps(p, v); }
   FloatLanes operator+(FloatLanes o) const { return {_mm512_add_ps(v, o.v)}; }
   FloatLanes operator-(FloatLanes o) const { return {_mm512_sub_ps(v, o.v)}; }
@@ -252,6 +271,32 @@ inline FloatLanes<8> half_of(FloatLanes<16> x) {
 }
 inline float reduce_min(FloatLanes<16> x) { return reduce_min(min(half_of<0>(x), half_of<1>(x))); }
 inline float reduce_max(FloatLanes<16> x) { return reduce_max(max(half_of<0>(x), half_of<1>(x))); }
+
+// Register j holds row j in its low 256 bits and row j + 8 in its high ones,
+// so the 8-lane transpose's first two steps run on both halves at once; one
+// two-source permute per field then interleaves the 128-bit quarters.
+// (Zero-masked forms under a full mask for GCC 12's sake, as above.)
+inline void FloatLanes<16>::load_transposed8(const float* rows, FloatLanes (&out)[8]) {
+  const auto unpacklo = [](__m512 a, __m512 b) { return _mm512_maskz_unpacklo_ps(0xffff, a, b); };
+  const auto unpackhi = [](__m512 a, __m512 b) { return _mm512_maskz_unpackhi_ps(0xffff, a, b); };
+  const auto shuffle = []<int Imm>(__m512 a, __m512 b) { return _mm512_maskz_shuffle_ps(0xffff, a, b, Imm); };
+  const auto two_rows = [&](int j) {
+    const __m512d low = _mm512_castpd256_pd512(_mm256_castps_pd(_mm256_loadu_ps(rows + 8 * j)));
+    return _mm512_castpd_ps(_mm512_maskz_insertf64x4(0xff, low, _mm256_castps_pd(_mm256_loadu_ps(rows + 8 * (j + 8))), 1));
+  };
+  __m512 lo[4], hi[4], tlo[4], thi[4];  // rows 0-3 (and 8-11) and 4-7 (and 12-15)
+  for (int j = 0; j < 4; ++j) lo[j] = two_rows(j), hi[j] = two_rows(j + 4);
+  transpose4_in_lanes(lo, tlo, unpacklo, unpackhi, shuffle);
+  transpose4_in_lanes(hi, thi, unpacklo, unpackhi, shuffle);
+  // tlo[k]'s quarters: element k of rows 0-3, element k + 4 of rows 0-3, element k of rows 8-11, k + 4 of 8-11;
+  // thi[k]'s the same of rows 4-7 and 12-15.
+  const __m512i even = _mm512_setr_epi32(0, 1, 2, 3, 16, 17, 18, 19, 8, 9, 10, 11, 24, 25, 26, 27);
+  const __m512i odd = _mm512_setr_epi32(4, 5, 6, 7, 20, 21, 22, 23, 12, 13, 14, 15, 28, 29, 30, 31);
+  for (int k = 0; k < 4; ++k) {
+    out[k] = {_mm512_permutex2var_ps(tlo[k], even, thi[k])};
+    out[k + 4] = {_mm512_permutex2var_ps(tlo[k], odd, thi[k])};
+  }
+}
 #endif
 
 }  // namespace raybench::simd
