@@ -145,18 +145,17 @@ inline unsigned load_group(const Ray* rays, int n, Packet& p) {
     std::copy_n(reinterpret_cast<const float*>(rays), 8 * n, padded.data());
     F::load_transposed8(padded.data(), fields);
   }
-  const auto field = [&](int k) { return fields[k]; };
   const F inf = F::set1(std::numeric_limits<float>::infinity());
   auto usable = F::set1(0.0f) <= F::set1(0.0f);  // every lane
   for (int a = 0; a < 3; ++a) {
-    p.org[a] = field(a);
-    p.dir[a] = field(4 + a);
+    p.org[a] = fields[a];
+    p.dir[a] = fields[4 + a];
     p.inv_dir[a] = F::set1(1.0f) / p.dir[a];  // Slab::precompute's 1/d, rounded alike
     p.fused[a] = p.org[a] * p.inv_dir[a];
     usable = usable & (p.org[a].abs() < inf) & (p.dir[a].abs() < inf) & (p.inv_dir[a].abs() < inf);
   }
-  p.tnear = field(3);
-  p.tfar = field(7);
+  p.tnear = fields[3];
+  p.tfar = fields[7];
   return usable.mask();
 }
 
