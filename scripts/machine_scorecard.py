@@ -322,8 +322,9 @@ def render_coherent(rows):
     met = sum(t["status"] == "met" for t in evaluated)
     out = ["", "## Coherent rays (issue 32)", "",
            "Rays in screen tiles (docs/raysets.md#coherent-orders), one thread. Our best coherent mode is the fastest "
-           "backend of ours with a `packet` option; Embree's the fastest of `embree:packet4/8/16` and `embree:stream`, "
-           "with the coherent or the incoherent flag (`:incoherent`).",
+           "backend of ours with a `packet` option, on any of our builds; Embree's the fastest of `embree:packet4/8/16` "
+           "and `embree:stream`, on any of its builds (e.g. `embree:high:packet16`), with the coherent or the "
+           "incoherent flag (`:incoherent`).",
            "", "| scene | ray kind | our best coherent | Embree's best coherent | ours / Embree's best coherent "
            "| ours / `embree` |", "|---|---|---|---|---:|---:|"]
     for x in lines:
