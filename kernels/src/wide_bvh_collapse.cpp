@@ -7,7 +7,8 @@
 // Guarantee: every triangle of the BVH2 is in exactly one pack; the result
 // is the same bytes for any thread count (each task writes only its own
 // slots); NaN or infinite boxes and costs (a broken mesh, coordinates past
-// about 3.7e18) still give a valid tree, never a pack of more than W.
+// about 3.7e18) still give a valid tree, never a leaf of more than
+// max_leaf_packs packs of W.
 // measured (optimal against greedy, costs tried, build time):
 // docs/notes/kernels-collapse.md
 #include <algorithm>
@@ -114,11 +115,13 @@ void order_children(WideNode<W>& node) {
 // them) among all wide trees whose nodes are cuts of the BVH2: the dynamic
 // programme of Ylitie, Karras & Laine (HPG 2017, section 4.1). Bottom-up, for
 // every BVH2 node n and slot count k = 1..W, the cheapest way to hold n's
-// subtree in at most k child slots of a wide node: one slot (n as a pack of
-// its triangles, if at most W, or as a wide node of its own), or n's two
-// children sharing the k slots. Any BVH2 subtree of at most W triangles may
-// become a pack, so the BVH2 is best built with small leaves (the backends'
-// quality builds use leaf_granularity 1) and the collapse gathers them. It
+// subtree in at most k child slots of a wide node: one slot (n as a leaf of
+// ceil(triangles / W) packs, if at most max_leaf_packs, or as a wide node of
+// its own), or n's two children sharing the k slots. Any BVH2 subtree small
+// enough may become a leaf, so the BVH2 is best built with small leaves (the
+// backends' quality builds use leaf_granularity 1) and the collapse gathers
+// them. A leaf of several packs pays where its children's boxes would
+// overlap most (large triangles: architectural interiors). It
 // fills nodes fuller than the greedy collapse (open the largest child until
 // W; Wald et al., RT 2008). measured, with the costs tried and dropped:
 // docs/notes/kernels-collapse.md
@@ -126,8 +129,13 @@ template <int W>
 class Collapser {
  public:
   Collapser(const Bvh2& bvh2, std::span<const Triangle> triangles, WideLeaves leaves, WideLaneOrder lane_order,
-            WideBvh<W>& out)
-      : bvh2_(bvh2), triangles_(triangles), leaves_(leaves), lane_order_(lane_order), out_(out) {}
+            int max_leaf_packs, WideBvh<W>& out)
+      : bvh2_(bvh2),
+        triangles_(triangles),
+        leaves_(leaves),
+        lane_order_(lane_order),
+        max_leaf_triangles_(static_cast<std::uint32_t>(max_leaf_packs) * W),
+        out_(out) {}
 
   void run() {
     const Bvh2Node& root = bvh2_.nodes[0];
@@ -136,7 +144,7 @@ class Collapser {
       expect_fits_a_pack(root);
       plans_.push_back({});
       plans_[0].kids[0] = 0;
-      plans_[0].child[0] = add_pack(0);
+      plans_[0].child[0] = add_leaf(0, root.prim_count);
       plans_[0].count = 1;
     } else {
       choose_slots();
@@ -147,6 +155,8 @@ class Collapser {
       pack_roots_.reserve(bvh2_.nodes.size() / 2 + 1);
       plan(0, 0);
     }
+    if (pack_roots_.size() > WideBvh<W>::kMaxPacks)
+      throw std::length_error("collapse_bvh2: more than " + std::to_string(WideBvh<W>::kMaxPacks) + " packs");
     out_.nodes.resize(plans_.size());
     out_.pack_prims.resize(pack_roots_.size() * W);
     switch (leaves_) {
@@ -175,6 +185,12 @@ class Collapser {
     std::uint32_t child[W];  // what WideNode::child will hold for each
     int count = 0;
   };
+  // A pack: the BVH2 subtree of its leaf, and which W of the subtree's
+  // triangles (in the BVH2's order) it holds.
+  struct PackRoot {
+    std::uint32_t bvh2_node;
+    std::uint32_t chunk;
+  };
 
   static void expect_fits_a_pack(const Bvh2Node& leaf) {
     if (leaf.prim_count > W)
@@ -185,7 +201,8 @@ class Collapser {
   struct Slots {
     std::int8_t left[W];    // left[k - 1]: slots of the left child when the subtree has k; 0: one slot, itself
     std::int8_t as_node_left = 0;  // as a wide node of its own: slots of its left child
-    bool as_pack = false;   // in one slot: a pack (or else a wide node)
+    bool as_leaf = false;   // in one slot: a leaf of packs (or else a wide node)
+    std::uint32_t triangles = 0;  // in the subtree
   };
 
   void choose_slots() {
@@ -208,7 +225,8 @@ class Collapser {
     std::fill(s.left, s.left + W, std::int8_t{0});
     if (node.is_leaf()) {
       expect_fits_a_pack(node);
-      s.as_pack = true;
+      s.as_leaf = true;
+      s.triangles = node.prim_count;
       std::fill(g, g + W, area);
       if (hit_chance_) hit_chance_[n] = leaf_hit_chance(node);
       return node.prim_count;
@@ -255,13 +273,16 @@ class Collapser {
       }
     }
     const float as_node = area + split[W - 1];
-    const float as_pack = triangles <= W ? area : kInf;
-    // A pack unless a wide node costs less: the same choice as
-    // as_pack <= as_node for finite costs, but never a pack of more than
-    // W triangles, even when both costs are infinite or NaN.
-    s.as_pack = triangles <= W && !(as_node < as_pack);
+    // A leaf of ceil(triangles / W) packs, each a test.
+    const bool fits = triangles <= max_leaf_triangles_;
+    const float as_leaf = fits ? area * static_cast<float>((triangles + W - 1) / W) : kInf;
+    // A leaf unless a wide node costs less: the same choice as
+    // as_leaf <= as_node for finite costs, but never a leaf of more than
+    // max_leaf_packs packs, even when both costs are infinite or NaN.
+    s.as_leaf = fits && !(as_node < as_leaf);
+    s.triangles = triangles;
     s.as_node_left = split_left[W - 1];
-    const float one_slot = std::min(as_pack, as_node);
+    const float one_slot = std::min(as_leaf, as_node);
     g[0] = one_slot;
     for (int k = 2; k <= W; ++k) {
       g[k - 1] = one_slot;
@@ -299,9 +320,13 @@ class Collapser {
     add_kids(p, bvh2_.nodes[n].first_index + 1, k - left);
   }
 
-  std::uint32_t add_pack(std::uint32_t bvh2_node) {
-    pack_roots_.push_back(bvh2_node);
-    return WideBvh<W>::kLeafBit | static_cast<std::uint32_t>(pack_roots_.size() - 1);
+  // The leaf of the BVH2 subtree at `bvh2_node`, of `triangles` triangles:
+  // its packs, consecutive.
+  std::uint32_t add_leaf(std::uint32_t bvh2_node, std::uint32_t triangles) {
+    const auto first = static_cast<std::uint32_t>(pack_roots_.size());
+    const std::uint32_t packs = std::max<std::uint32_t>(1, (triangles + W - 1) / W);
+    for (std::uint32_t chunk = 0; chunk < packs; ++chunk) pack_roots_.push_back({bvh2_node, chunk});
+    return WideBvh<W>::leaf_ref(first & (WideBvh<W>::kMaxPacks - 1), packs);  // run() throws past kMaxPacks
   }
 
   // Plans the wide node for the BVH2 subtree at `n2` (an inner node), then
@@ -316,7 +341,7 @@ class Collapser {
     plans_.push_back(p);
     for (int i = 0; i < p.count; ++i) {
       const std::uint32_t kid = p.kids[i];
-      const std::uint32_t child = slots_[kid].as_pack ? add_pack(kid) : plan(kid, level + 1);  // grows plans_
+      const std::uint32_t child = slots_[kid].as_leaf ? add_leaf(kid, slots_[kid].triangles) : plan(kid, level + 1);  // grows plans_
       plans_[index].child[i] = child;
     }
     return index;
@@ -368,17 +393,23 @@ class Collapser {
     order_children(node);
   }
 
-  // A BVH2 subtree of at most W triangles becomes one pack.
+  // Pack i: the triangles chunk * W .. chunk * W + W - 1 of its leaf's BVH2
+  // subtree (at most max_leaf_packs * W triangles), in the BVH2's order.
   void fill_pack(std::size_t i) {
+    const PackRoot root = pack_roots_[i];
     std::uint32_t ids[W];
-    std::uint32_t count = 0;
-    std::uint32_t todo[W];  // a subtree of at most W triangles has at most W leaves
+    std::uint32_t count = 0, seen = 0;
+    const std::uint32_t first = root.chunk * W;
+    // A subtree of at most kMaxLeafPacks * W triangles has fewer leaves, so
+    // the stack holds at most that many nodes.
+    std::uint32_t todo[WideBvh<W>::kMaxLeafPacks * W];
     int top = 0;
-    todo[top++] = pack_roots_[i];
-    while (top > 0) {
+    todo[top++] = root.bvh2_node;
+    while (top > 0 && count < W) {
       const Bvh2Node& n = bvh2_.nodes[todo[--top]];
       if (n.is_leaf()) {
-        for (std::uint32_t k = 0; k < n.prim_count; ++k) ids[count++] = bvh2_.prim_ids[n.first_index + k];
+        for (std::uint32_t k = 0; k < n.prim_count; ++k, ++seen)
+          if (seen >= first && count < W) ids[count++] = bvh2_.prim_ids[n.first_index + k];
       } else {
         todo[top++] = n.first_index + 1;
         todo[top++] = n.first_index;
@@ -402,6 +433,7 @@ class Collapser {
   std::span<const Triangle> triangles_;
   WideLeaves leaves_;
   WideLaneOrder lane_order_;
+  std::uint32_t max_leaf_triangles_;
   WideBvh<W>& out_;
   std::vector<Plan> plans_;
   // BVH2 levels above parallel_depth_ are evaluated as parallel tasks: at
@@ -415,19 +447,26 @@ class Collapser {
   std::vector<Slots> slots_;                // per BVH2 node
   std::unique_ptr<float[]> cost_;           // per BVH2 node, W entries: its subtree in at most 1..W slots
   std::unique_ptr<float[]> hit_chance_;     // per BVH2 node, for kOcclusion only: leaf_hit_chance, combined above
-  std::vector<std::uint32_t> pack_roots_;  // the BVH2 subtree of each pack
+  std::vector<PackRoot> pack_roots_;
 };
 
 }  // namespace
 
 template <int W>
 WideBvh<W> collapse_bvh2(const Bvh2& bvh2, std::span<const Triangle> triangles, WideLeaves leaves,
-                         WideLaneOrder lane_order) {
+                         WideLaneOrder lane_order, int max_leaf_packs) {
   if (W != 8 && leaves == WideLeaves::kVertices)
     throw std::invalid_argument("collapse_bvh2: vertex leaves (the watertight test) are 8 wide only");
+  if (max_leaf_packs == 0) max_leaf_packs = default_leaf_packs<W>(leaves);
+  if (max_leaf_packs < 1 || max_leaf_packs > static_cast<int>(WideBvh<W>::kMaxLeafPacks))
+    throw std::invalid_argument("collapse_bvh2: max_leaf_packs " + std::to_string(max_leaf_packs) + " is not in 1.." +
+                                std::to_string(WideBvh<W>::kMaxLeafPacks));
+  // The watertight traversal tests one pack per leaf (wide_bvh_traverse.h).
+  if (leaves == WideLeaves::kVertices && max_leaf_packs != 1)
+    throw std::invalid_argument("collapse_bvh2: vertex leaves (the watertight test) hold one pack each");
   WideBvh<W> out;
   if (triangles.empty()) return out;  // no nodes: traversal returns at once
-  Collapser<W>(bvh2, triangles, leaves, lane_order, out).run();
+  Collapser<W>(bvh2, triangles, leaves, lane_order, max_leaf_packs, out).run();
   out.bounds = out.nodes[0].bounds.bounds();
   return out;
 }
@@ -439,14 +478,18 @@ double WideBvh<W>::sah_cost() const {
   if (!(root_area > 0.0)) return 0.0;
   double cost = root_area;  // the root is always visited
   for (const WideNode<W>& n : nodes)
-    for (int lane = 0; lane < W; ++lane)
-      if (n.child[lane] != kEmptyChild) cost += n.bounds.lane(lane).half_area();  // an inner node or a pack
+    for (int lane = 0; lane < W; ++lane) {
+      const std::uint32_t child = n.child[lane];
+      if (child == kEmptyChild) continue;
+      const double tests = (child & kLeafBit) ? pack_count(child) : 1;  // a leaf's packs, or an inner node
+      cost += tests * n.bounds.lane(lane).half_area();
+    }
   return cost / root_area;
 }
 
 template struct WideBvh<4>;
 template struct WideBvh<8>;
-template WideBvh<4> collapse_bvh2<4>(const Bvh2&, std::span<const Triangle>, WideLeaves, WideLaneOrder);
-template WideBvh<8> collapse_bvh2<8>(const Bvh2&, std::span<const Triangle>, WideLeaves, WideLaneOrder);
+template WideBvh<4> collapse_bvh2<4>(const Bvh2&, std::span<const Triangle>, WideLeaves, WideLaneOrder, int);
+template WideBvh<8> collapse_bvh2<8>(const Bvh2&, std::span<const Triangle>, WideLeaves, WideLaneOrder, int);
 
 }  // namespace raybench

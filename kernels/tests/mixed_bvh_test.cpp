@@ -495,7 +495,7 @@ void expect_pack_layout(const MixedScene& s, const MixedWideBvh<W>& m) {
   for (const WideNode<W>& n : m.nodes)
     for (int lane = 0; lane < W; ++lane)
       if (n.child[lane] != WideBvh<W>::kEmptyChild && (n.child[lane] & WideBvh<W>::kLeafBit))
-        pack_box[n.child[lane] & ~WideBvh<W>::kLeafBit] = n.bounds.lane(lane);
+        pack_box[WideBvh<W>::first_pack(n.child[lane])] = n.bounds.lane(lane);
   std::size_t analytic = 0;
   for (std::size_t pack = 0; pack < pack_count; ++pack) {
     // The packs of triangles only first (no MixedPack), then the others.

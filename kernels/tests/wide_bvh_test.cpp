@@ -80,9 +80,9 @@ void check(const WideBvh<W>& bvh, const std::vector<Triangle>& tris, std::uint32
     }
     EXPECT_TRUE(parent.contains(box));
     if (child & WideBvh<W>::kLeafBit) {
-      const std::uint32_t pack = child & ~WideBvh<W>::kLeafBit;
-      for (int i = 0; i < W; ++i) {
-        const std::int32_t id = bvh.pack_prims[W * pack + i];
+      const std::uint32_t first = WideBvh<W>::first_pack(child);
+      for (std::uint32_t i = 0; i < W * WideBvh<W>::pack_count(child); ++i) {
+        const std::int32_t id = bvh.pack_prims[W * first + i];
         if (id < 0) continue;
         leaves_of[static_cast<std::size_t>(id)].push_back(box);
         BBox t = triangle_bounds(tris[id]);
@@ -211,6 +211,66 @@ TEST_P(WideBvhBuild, ClosestAndAnyHitMatchBruteForceInEveryLaneOrder) {
   EXPECT_GT(expect_same_hits_as_brute_force(bvh, tris, rays), 500);  // many hits, not only misses
   }
   });
+}
+
+// Large triangles stacked over one another (walls a few units apart, as in
+// an architectural interior): any split of them leaves children whose boxes
+// overlap almost whole, so a leaf of several packs costs less than a node
+// over them. The collapse makes such leaves, never of more packs than
+// allowed; every triangle is in one, and rays get the brute-force answers
+// (a leaf's packs tested in order, each within the hits before it).
+TEST_P(WideBvhBuild, StackedWallsShareLeavesOfSeveralPacksWithinTheLimit) {
+  std::vector<Triangle> tris;
+  for (int i = 0; i < 40; ++i) {
+    const float z = 0.25f * static_cast<float>(i), skew = 0.01f * static_cast<float>(i % 7);
+    tris.push_back({{-10, -10, z}, {10, -10, z + skew}, {10, 10, z}});
+    tris.push_back({{-10, -10, z}, {10, 10, z}, {-10, 10, z + skew}});
+  }
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 2000; ++i) {
+    Ray r{{u(rng) * 12, u(rng) * 12, -5.0f + 25.0f * (u(rng) + 1.0f) / 2}, 0.0f,
+          normalize(Vec3f{u(rng), u(rng), u(rng)}), kInf};
+    if (i % 3 == 0) r.tfar = 3.0f;
+    rays.push_back(r);
+  }
+  Bvh2BuildOptions options;
+  options.leaf_granularity = 1;
+  options.max_leaf_size = 8;
+  const Bvh2 bvh2 = build_bvh2(tris, GetParam(), options);
+  for (int packs : {1, 2, 3, 8}) {
+    SCOPED_TRACE("leaves of at most " + std::to_string(packs) + " packs");
+    const Bvh8 bvh = collapse_bvh2<8>(bvh2, tris, WideLeaves::kMollerTrumbore, WideLaneOrder::kByArea, packs);
+    std::uint32_t most = 0;
+    for (const WideNode<8>& node : bvh.nodes)
+      for (std::uint32_t child : node.child)
+        if (child != Bvh8::kEmptyChild && (child & Bvh8::kLeafBit)) most = std::max(most, Bvh8::pack_count(child));
+    EXPECT_LE(most, static_cast<std::uint32_t>(packs));
+    if (packs > 1) {
+      EXPECT_GT(most, 1u);
+    }
+    std::vector<std::vector<BBox>> leaves_of(tris.size());
+    check(bvh, tris, 0, bvh.bounds, splits_triangles(GetParam()), leaves_of);
+    for (std::size_t i = 0; i < tris.size(); ++i) EXPECT_GE(leaves_of[i].size(), 1u) << "triangle " << i;
+    EXPECT_GT(expect_same_hits_as_brute_force(bvh, tris, rays), 500);  // many hits, not only misses
+  }
+  EXPECT_THROW(collapse_bvh2<8>(bvh2, tris, WideLeaves::kMollerTrumbore, WideLaneOrder::kByArea, -1), std::invalid_argument);
+  // The watertight leaves hold one pack each (their traversal tests one), by default and always.
+  const Bvh8 watertight = collapse_bvh2<8>(bvh2, tris, WideLeaves::kVertices);
+  for (const WideNode<8>& node : watertight.nodes)
+    for (std::uint32_t child : node.child)
+      if (child != Bvh8::kEmptyChild && (child & Bvh8::kLeafBit)) {
+        EXPECT_EQ(Bvh8::pack_count(child), 1u);
+      }
+  EXPECT_THROW(collapse_bvh2<8>(bvh2, tris, WideLeaves::kVertices, WideLaneOrder::kByArea, 2), std::invalid_argument);
+  // The default: leaves of several packs for the Möller-Trumbore leaves.
+  std::uint32_t most = 0;
+  for (const WideNode<8>& node : collapse_bvh2<8>(bvh2, tris).nodes)
+    for (std::uint32_t child : node.child)
+      if (child != Bvh8::kEmptyChild && (child & Bvh8::kLeafBit)) most = std::max(most, Bvh8::pack_count(child));
+  EXPECT_GT(most, 1u);
+  EXPECT_THROW(collapse_bvh2<8>(bvh2, tris, WideLeaves::kMollerTrumbore, WideLaneOrder::kByArea, 9), std::invalid_argument);
 }
 
 TEST_P(WideBvhBuild, EveryRayKindOnAMeshMatchesBruteForce) {
@@ -449,7 +509,8 @@ TEST_P(WideBvhBuild, SahCostCountsNodeVisitsAndPackTests) {
 // the collapse's dynamic programme, and exponential, so for small trees only.
 class ExhaustiveCollapse {
  public:
-  ExhaustiveCollapse(const Bvh2& bvh2, std::size_t width) : bvh2_(bvh2), width_(width) {}
+  ExhaustiveCollapse(const Bvh2& bvh2, std::size_t width, std::size_t max_leaf_packs)
+      : bvh2_(bvh2), width_(width), max_leaf_packs_(max_leaf_packs) {}
 
   // The root is always a wide node.
   double least_cost() { return as_node(0); }
@@ -476,10 +537,12 @@ class ExhaustiveCollapse {
     return out;
   }
   double area(std::uint32_t n) const { return bvh2_.nodes[n].bounds.half_area(); }
-  // n in one child slot: a pack of its triangles, or a wide node.
+  // n in one child slot: a leaf of ceil(triangles / width) packs, a test
+  // each, or a wide node.
   double in_one_slot(std::uint32_t n) {
-    const double pack = triangles(n) <= width_ ? area(n) : std::numeric_limits<double>::infinity();
-    return bvh2_.nodes[n].is_leaf() ? pack : std::min(pack, as_node(n));
+    const std::size_t packs = (triangles(n) + width_ - 1) / width_;
+    const double leaf = packs <= max_leaf_packs_ ? static_cast<double>(packs) * area(n) : std::numeric_limits<double>::infinity();
+    return bvh2_.nodes[n].is_leaf() ? leaf : std::min(leaf, as_node(n));
   }
   // n as a wide node: its visit, then its children, the best cut below it.
   double as_node(std::uint32_t n) {
@@ -498,13 +561,14 @@ class ExhaustiveCollapse {
 
   const Bvh2& bvh2_;
   std::size_t width_;
+  std::size_t max_leaf_packs_;
   std::map<std::uint32_t, double> node_cost_;
 };
 
 TEST_P(WideBvhBuild, TheCollapseHasTheLeastSahCostOfAnyWideTreeCutFromTheBvh2) {
   for_each_width([&](auto width) {
     constexpr int W = width();
-    for (std::size_t n : {2u, 5u, 9u, 13u, 18u}) {
+    for (std::size_t n : {2u, 5u, 9u, 13u, 18u, 30u}) {
       for (std::uint64_t seed : {1u, 2u, 3u}) {
         const auto tris = random_soup(n, seed);
         for (int granularity : {1, W}) {  // small BVH2 leaves, and leaves of up to W
@@ -513,9 +577,15 @@ TEST_P(WideBvhBuild, TheCollapseHasTheLeastSahCostOfAnyWideTreeCutFromTheBvh2) {
           options.max_leaf_size = W;
           const Bvh2 bvh2 = build_bvh2(tris, GetParam(), options);
           if (bvh2.nodes[0].is_leaf()) continue;  // nothing to choose
-          const double least = ExhaustiveCollapse(bvh2, W).least_cost() / bvh2.nodes[0].bounds.half_area();
-          EXPECT_NEAR(collapse_bvh2<W>(bvh2, tris).sah_cost(), least, 1e-5 * least)
-              << n << " triangles, seed " << seed << ", granularity " << granularity << ", width " << W;
+          for (int packs : {1, 2, 3}) {  // leaves of one pack, and of several
+            if (n > 18 && granularity == 1) continue;  // the exhaustive search's time
+            const double least =
+                ExhaustiveCollapse(bvh2, W, static_cast<std::size_t>(packs)).least_cost() / bvh2.nodes[0].bounds.half_area();
+            EXPECT_NEAR(collapse_bvh2<W>(bvh2, tris, WideLeaves::kMollerTrumbore, WideLaneOrder::kByArea, packs).sah_cost(),
+                        least, 1e-5 * least)
+                << n << " triangles, seed " << seed << ", granularity " << granularity << ", width " << W << ", packs "
+                << packs;
+          }
         }
       }
     }
@@ -562,10 +632,11 @@ std::array<int, W> groups_of_root_lanes(const WideBvh<W>& bvh, std::int32_t firs
       todo.pop_back();
       if (ref == WideBvh<W>::kEmptyChild) continue;
       if (ref & WideBvh<W>::kLeafBit) {
-        const std::uint32_t pack = ref & ~WideBvh<W>::kLeafBit;
-        for (int i = 0; i < W; ++i)
-          if (const std::int32_t id = bvh.pack_prims[WideBvh<W>::slot(pack, i)]; id >= 0)
-            groups[lane] |= id < first_of_second ? 1 : 2;
+        const std::uint32_t first = WideBvh<W>::first_pack(ref);
+        for (std::uint32_t pack = first; pack != first + WideBvh<W>::pack_count(ref); ++pack)
+          for (int i = 0; i < W; ++i)
+            if (const std::int32_t id = bvh.pack_prims[WideBvh<W>::slot(pack, i)]; id >= 0)
+              groups[lane] |= id < first_of_second ? 1 : 2;
       } else {
         todo.insert(todo.end(), bvh.nodes[ref].child, bvh.nodes[ref].child + W);
       }

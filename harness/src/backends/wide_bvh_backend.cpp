@@ -1,6 +1,7 @@
 // Our wide BVHs: a BVH2 (binned SAH by default, TBB-parallel), collapsed to
 // 8-wide (bvh8: AVX2) or 4-wide (bvh4: SSE) nodes, traversed with one SIMD
-// slab test per node and leaves of up to W triangles tested at once.
+// slab test per node and leaves of packs of up to W triangles, a pack tested
+// at once (bvh8: up to 4 packs per leaf, wide_bvh.h).
 // Options, in any order, each at most once:
 //   a triangle test: mt (Möller–Trumbore in its stored-normal form,
 //     prim/triangle_mt_normal.h, simd/wide_triangle.h; the default),
@@ -118,8 +119,9 @@ template <int W>
 std::vector<BackendInfo> wide_backend_names() {
   const std::string family = fmt::format("bvh{}", W);
   std::vector<BackendInfo> out{
-      {family, fmt::format("{}-wide BVH collapsed from bvh2, {} node and leaf tests, Moller-Trumbore leaves of {}", W,
-                           kHaveAvx2 ? (W == 8 ? "AVX2" : "SSE") : "scalar fallback", W)}};
+      {family, fmt::format("{}-wide BVH collapsed from bvh2, {} node and leaf tests, Moller-Trumbore leaves of up to "
+                           "{} packs of {}",
+                           W, kHaveAvx2 ? (W == 8 ? "AVX2" : "SSE") : "scalar fallback", default_leaf_packs<W>(WideLeaves::kMollerTrumbore), W)}};
   for (Bvh2Builder b : kBvh2Builders) {
     if (b == Bvh2Builder::kBinnedSah) continue;  // the default: plain "bvh8"
     out.push_back({family + ":" + std::string(to_string(b)),

@@ -161,8 +161,10 @@ MixedWideBvh<W> build_mixed_wide_bvh(const PrimitiveSpans& prims, int reinsertio
       stand_ins[id] = id < prims.triangles.size() ? prims.triangles[id] : mixed_stand_in(bounds[id]);
   });
   MixedWideBvh<W> m;
+  // Leaves of one pack: the packs with analytic primitives move to the end
+  // below, which would part a leaf's consecutive packs.
   static_cast<WideBvh<W>&>(m) = collapse_bvh2<W>(bvh2, stand_ins, TriangleLeaf::kLeaves,
-                                                 quality ? WideLaneOrder::kOcclusion : WideLaneOrder::kByArea);
+                                                 quality ? WideLaneOrder::kOcclusion : WideLaneOrder::kByArea, 1);
 
   // Each pack with analytic primitives: its triangles to its first lanes,
   // repacked without the stand-ins, its analytic primitives to the lanes
@@ -253,7 +255,7 @@ MixedWideBvh<W> build_mixed_wide_bvh(const PrimitiveSpans& prims, int reinsertio
     for (std::size_t i = r.begin(); i != r.end(); ++i)
       for (std::uint32_t& child : m.nodes[i].child)
         if (child != WideBvh<W>::kEmptyChild && (child & WideBvh<W>::kLeafBit))
-          child = WideBvh<W>::kLeafBit | new_index[child & ~WideBvh<W>::kLeafBit];
+          child = WideBvh<W>::leaf_ref(new_index[WideBvh<W>::first_pack(child)], 1);
   });
   return m;
 }

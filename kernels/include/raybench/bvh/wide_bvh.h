@@ -1,7 +1,7 @@
 // Wide BVHs collapsed from a Bvh2: WideBvh<8> (Bvh8) and WideBvh<4> (Bvh4).
 // Each node holds its W children's bounds structure-of-arrays (BBoxWide), so
-// one SIMD slab test visits all of them; leaves are TrianglePack<W>s of up to
-// W triangles, tested at once.
+// one SIMD slab test visits all of them; a leaf is one or more consecutive
+// TrianglePack<W>s of up to W triangles each, a pack tested at once.
 // The collapse chooses, among all wide trees whose nodes are cuts of the
 // BVH2, the one of least SAH cost (sah_cost below), by the dynamic programme
 // of Ylitie, Karras & Laine (HPG 2017); any BVH2 subtree of at most W
@@ -36,7 +36,7 @@ struct alignas(64) WideNode {
   using Order = std::conditional_t<W == 8, std::uint32_t, std::uint8_t>;
 
   BBoxWide<W> bounds;       // empty boxes in unused lanes: no ray enters them
-  // kEmptyChild, an inner node index, or kLeafBit | pack index, in the
+  // kEmptyChild, an inner node index, or a leaf (WideBvh::leaf_ref), in the
   // collapse's WideLaneOrder, empty lanes last (the any-hit traversal's order).
   std::uint32_t child[W];
   // far_to_near[octant]: the W lanes, kOrderBits each, lowest bits first, from
@@ -80,8 +80,18 @@ enum class WideLaneOrder { kByArea, kBvh2, kOcclusion };
 template <int W>
 struct WideBvh {
   static constexpr int kWidth = W;
+  // A child that is a leaf: kLeafBit | (packs - 1) << kPackCountShift |
+  // first pack; its packs are consecutive, tested in order.
   static constexpr std::uint32_t kLeafBit = 0x80000000u;
+  static constexpr int kPackCountShift = 28;
+  static constexpr std::uint32_t kMaxLeafPacks = 8;                            // what the 3 count bits hold
+  static constexpr std::uint32_t kMaxPacks = 1u << kPackCountShift;           // pack indices below it
   static constexpr std::uint32_t kEmptyChild = 0xffffffffu;
+  static constexpr std::uint32_t leaf_ref(std::uint32_t first_pack, std::uint32_t packs) {
+    return kLeafBit | (packs - 1) << kPackCountShift | first_pack;
+  }
+  static constexpr std::uint32_t first_pack(std::uint32_t leaf) { return leaf & (kMaxPacks - 1); }
+  static constexpr std::uint32_t pack_count(std::uint32_t leaf) { return (leaf >> kPackCountShift & 7u) + 1; }
 
   HugePageVector<WideNode<W>> nodes;               // nodes[0] is the root
   HugePageVector<TrianglePack<W>> packs;           // WideLeaves::kMollerTrumbore: up to W triangles each
@@ -104,20 +114,36 @@ struct WideBvh {
   }
   // Surface-area-heuristic cost of the wide tree, relative to the root's
   // area: visiting a node (one W-box test) and testing a pack (one W-triangle
-  // test) cost 1 each, weighted by the area of the box that leads to them.
+  // test) cost 1 each, weighted by the area of the box that leads to them
+  // (a leaf's box for each of its packs).
   // Not comparable with Bvh2::sah_cost, whose units are single tests.
   double sah_cost() const;
 };
 using Bvh8 = WideBvh<8>;
 using Bvh4 = WideBvh<4>;
 
+// Leaves of up to this many packs by default: 4 for the 8-wide tree's
+// Möller-Trumbore leaves (up to 32 triangles; Embree's BVH8 leaves hold up
+// to 28, in blocks of 4); one for the watertight vertex leaves, whose
+// traversal the multi-pack leaf step slows by more than their tree gains,
+// and for the 4-wide tree (not measured with more). Measured (eight scenes,
+// every ray kind): docs/notes/kernels-collapse.md.
+template <int W>
+constexpr int default_leaf_packs(WideLeaves leaves) {
+  return W == 8 && leaves != WideLeaves::kVertices ? 4 : 1;
+}
+
 // Collapses `bvh2` (whose leaves hold at most W triangles, as every builder
 // of bvh2_builders.h makes them with max_leaf_size W) over `triangles`, into
-// the wide tree of least sah_cost() among those whose nodes are cuts of it.
-// WideLeaves::kVertices needs W = 8 (std::invalid_argument otherwise).
+// the wide tree of least sah_cost() among those whose nodes are cuts of it
+// and whose leaves hold at most max_leaf_packs packs (1 to kMaxLeafPacks, 0
+// for default_leaf_packs; a BVH2 subtree of n triangles becomes
+// ceil(n / W) packs, filled in the BVH2's order). WideLeaves::kVertices
+// needs W = 8 and one pack per leaf (std::invalid_argument otherwise, as
+// for max_leaf_packs out of range).
 template <int W>
 WideBvh<W> collapse_bvh2(const Bvh2& bvh2, std::span<const Triangle> triangles,
                          WideLeaves leaves = WideLeaves::kMollerTrumbore,
-                         WideLaneOrder lane_order = WideLaneOrder::kByArea);
+                         WideLaneOrder lane_order = WideLaneOrder::kByArea, int max_leaf_packs = 0);
 
 }  // namespace raybench

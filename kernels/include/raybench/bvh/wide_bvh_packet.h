@@ -399,45 +399,48 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
       }
       update_bounds();
     } else if (ref & Bvh8::kLeafBit) {
-      const std::uint32_t pack = ref & ~Bvh8::kLeafBit;
-      if constexpr (kRayLanesLeaf<Leaf>) {
-        F best_t = reach, u = F::set1(0.0f), v = u;
-        alignas(64) int lane_of[kPacketRays];
-        unsigned hit_rays;
-        if constexpr (Leaf::kLeaves == WideLeaves::kMollerTrumbore)
-          hit_rays = intersect_pack_rays<AnyHit>(p, node_tnear, bvh.packs[pack], best_t, u, v, lane_of);
-        else
-          hit_rays = intersect_pack_rays<AnyHit>(p, node_tnear, bvh.edge_packs[pack], best_t, u, v, lane_of);
-        if (hit_rays) {
-          if constexpr (AnyHit) {
-            mark_occluded(hit_rays);
-          } else {
-            alignas(64) float us[kPacketRays], vs[kPacketRays];
-            best_t.storeu(tmax);
-            u.storeu(us);
-            v.storeu(vs);
-            for (unsigned lanes = hit_rays; lanes; lanes &= lanes - 1) {
-              const int i = std::countr_zero(lanes);
-              set_hit(i, pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane_of[i], tmax[i], us[i], vs[i]));
+      // The leaf's packs in order, as the single-ray traversal tests them.
+      const std::uint32_t first = Bvh8::first_pack(ref), end = first + Bvh8::pack_count(ref);
+      for (std::uint32_t pack = first; pack != end; ++pack) {
+        if constexpr (kRayLanesLeaf<Leaf>) {
+          F best_t = reach, u = F::set1(0.0f), v = u;
+          alignas(64) int lane_of[kPacketRays];
+          unsigned hit_rays;
+          if constexpr (Leaf::kLeaves == WideLeaves::kMollerTrumbore)
+            hit_rays = intersect_pack_rays<AnyHit>(p, node_tnear, bvh.packs[pack], best_t, u, v, lane_of);
+          else
+            hit_rays = intersect_pack_rays<AnyHit>(p, node_tnear, bvh.edge_packs[pack], best_t, u, v, lane_of);
+          if (hit_rays) {
+            if constexpr (AnyHit) {
+              mark_occluded(hit_rays);
+            } else {
+              alignas(64) float us[kPacketRays], vs[kPacketRays];
+              best_t.storeu(tmax);
+              u.storeu(us);
+              v.storeu(vs);
+              for (unsigned lanes = hit_rays; lanes; lanes &= lanes - 1) {
+                const int i = std::countr_zero(lanes);
+                set_hit(i, pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane_of[i], tmax[i], us[i], vs[i]));
+              }
+            }
+            update_bounds();
+          }
+        } else {
+          bool any = false;
+          for (unsigned lanes = active; lanes; lanes &= lanes - 1) {
+            const int i = std::countr_zero(lanes);
+            TriangleHit th{};
+            const int lane = Leaf::template intersect<AnyHit>(leaf_ray[i], tmax[i], bvh, pack, th);
+            if (lane < 0) continue;
+            any = true;
+            if constexpr (AnyHit) {
+              mark_occluded(1u << i);
+            } else {
+              set_hit(i, pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane, th.t, th.u, th.v));
             }
           }
-          update_bounds();
+          if (any) update_bounds();
         }
-      } else {
-        bool any = false;
-        for (unsigned lanes = active; lanes; lanes &= lanes - 1) {
-          const int i = std::countr_zero(lanes);
-          TriangleHit th{};
-          const int lane = Leaf::template intersect<AnyHit>(leaf_ray[i], tmax[i], bvh, pack, th);
-          if (lane < 0) continue;
-          any = true;
-          if constexpr (AnyHit) {
-            mark_occluded(1u << i);
-          } else {
-            set_hit(i, pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane, th.t, th.u, th.v));
-          }
-        }
-        if (any) update_bounds();
       }
     } else {
       const WideNode<8>& node = bvh.nodes[ref];

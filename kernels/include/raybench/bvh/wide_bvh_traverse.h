@@ -5,8 +5,8 @@
 // (WideNode::far_to_near), without sorting distances: one permutation orders
 // them and a table-driven compaction pushes them with two stores,
 // branch-free. Their entry distances go on the stack too, so a subtree
-// farther than the current hit is skipped when popped. Leaves are tested W
-// triangles at once. The traversal descends straight into the child it
+// farther than the current hit is skipped when popped. A leaf's packs are
+// tested in order, W triangles at once. The traversal descends straight into the child it
 // visits next instead of pushing it and popping it back, so a node with one
 // child entered (the commonest case) pushes nothing, as Embree's traversal
 // does (bvh_traverser1.h).
@@ -193,7 +193,7 @@ RAYBENCH_INLINE Hit pack_lane_hit(const WideBvh<W>& bvh, std::uint32_t pack, int
 // there, independent loads overlap; inside the traversal each could miss and
 // hold it up (measured: docs/notes/kernels-wide-traversal.md).
 // traverse_wide_from continues a ray's traversal in the subtree `start` (a
-// node or kLeafBit | pack) with the closest hit found so far, `hit` (none:
+// node or a leaf) with the closest hit found so far, `hit` (none:
 // the default Hit; its t is then the ray's tfar): what the packet traversal
 // (wide_bvh_packet.h) hands a ray to when its packet thins out. From the
 // root with no hit it is traverse_wide itself.
@@ -236,23 +236,49 @@ RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide_from(const W
   std::uint32_t ref = start;  // the node or leaf visited next
   for (;;) {
     if (ref & WideBvh<W>::kLeafBit) {
-      const std::uint32_t pack = ref & ~WideBvh<W>::kLeafBit;
-      TriangleHit th{};  // set when a lane hits (initialised: the scalar fallback sets it conditionally)
-      // Any hit: a lane hit, which is the whole answer. The leaf test need
-      // not find the closest lane (the watertight one stops at its first),
-      // and the triangle is not looked up in pack_prims, an array the
-      // traversal never reads otherwise, which the answer waited for
-      // (measured: docs/notes/kernels-wide-traversal.md).
-      const int lane = Leaf::template intersect<AnyHit>(leaf_ray, tmax, bvh, pack, th);
-      if constexpr (AnyHit) {
-        if (lane >= 0) return true;
-      } else if (lane >= 0) {
-        tmax = th.t;
-        reach = reach_bound(tmax);
+      // Tests one pack within the hit so far (tmax inclusive: on equal t a
+      // later pack's triangle wins, as a later lane within a pack); any hit:
+      // whether it hit.
+      const auto test_pack = [&](std::uint32_t pack) __attribute__((always_inline)) {
+        TriangleHit th{};  // set when a lane hits (initialised: the scalar fallback sets it conditionally)
+        // Any hit: a lane hit, which is the whole answer. The leaf test need
+        // not find the closest lane (the watertight one stops at its first),
+        // and the triangle is not looked up in pack_prims, an array the
+        // traversal never reads otherwise, which the answer waited for
+        // (measured: docs/notes/kernels-wide-traversal.md).
+        const int lane = Leaf::template intersect<AnyHit>(leaf_ray, tmax, bvh, pack, th);
+        if constexpr (!AnyHit) {
+          if (lane >= 0) {
+            tmax = th.t;
+            reach = reach_bound(tmax);
 #if defined(__AVX2__)
-        exit_bound = box_exit_bound<BoxTest>(tmax);
+            exit_bound = box_exit_bound<BoxTest>(tmax);
 #endif
-        hit = pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane, th.t, th.u, th.v);
+            hit = pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane, th.t, th.u, th.v);
+          }
+        }
+        return lane >= 0;
+      };
+      if constexpr (Leaf::kLeaves == WideLeaves::kVertices) {
+        // One pack per leaf (collapse_bvh2): a step over several packs
+        // slowed this traversal by 4-10 %, more than such leaves gain
+        // (measured: docs/notes/kernels-collapse.md).
+        const bool hit_here = test_pack(ref & ~WideBvh<W>::kLeafBit);
+        if constexpr (AnyHit)
+          if (hit_here) return true;
+      } else {
+        // The leaf's packs in order: the first, then any others (most
+        // leaves have one; a loop over all of them cost the single-pack
+        // leaves 4-5 %: docs/notes/kernels-collapse.md).
+        std::uint32_t pack = WideBvh<W>::first_pack(ref), more = WideBvh<W>::pack_count(ref) - 1;
+        if constexpr (AnyHit) {
+          if (test_pack(pack)) return true;
+          for (; more != 0; --more)
+            if (test_pack(++pack)) return true;
+        } else {
+          test_pack(pack);
+          for (; more != 0; --more) test_pack(++pack);
+        }
       }
     } else {
       const WideNode<W>& node = bvh.nodes[ref];
