@@ -121,7 +121,8 @@ std::vector<BackendInfo> wide_backend_names() {
   std::vector<BackendInfo> out{
       {family, fmt::format("{}-wide BVH collapsed from bvh2, {} node and leaf tests, Moller-Trumbore leaves of up to "
                            "{} packs of {}",
-                           W, kHaveAvx2 ? (W == 8 ? "AVX2" : "SSE") : "scalar fallback", default_leaf_packs<W>(WideLeaves::kMollerTrumbore), W)}};
+                           W, kHaveAvx2 ? (W == 8 ? "AVX2" : "SSE") : "scalar fallback",
+                           default_leaf_packs<W>(WideLeaves::kMollerTrumbore), W)}};
   for (Bvh2Builder b : kBvh2Builders) {
     if (b == Bvh2Builder::kBinnedSah) continue;  // the default: plain "bvh8"
     out.push_back({family + ":" + std::string(to_string(b)),

@@ -6,10 +6,10 @@
 // them and a table-driven compaction pushes them with two stores,
 // branch-free. Their entry distances go on the stack too, so a subtree
 // farther than the current hit is skipped when popped. A leaf's packs are
-// tested in order, W triangles at once. The traversal descends straight into the child it
-// visits next instead of pushing it and popping it back, so a node with one
-// child entered (the commonest case) pushes nothing, as Embree's traversal
-// does (bvh_traverser1.h).
+// tested in order, W triangles at once. The traversal descends straight
+// into the child it visits next instead of pushing it and popping it back,
+// so a node with one child entered (the commonest case) pushes nothing, as
+// Embree's traversal does (bvh_traverser1.h).
 // Any hit (shadow rays) returns at the first hit in the interval and orders
 // nothing per ray: the children entered are pushed in the node's lane order,
 // ref only (its interval never shrinks), as Embree's any-hit traversal does.
@@ -263,7 +263,7 @@ RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide_from(const W
         // One pack per leaf (collapse_bvh2): a step over several packs
         // slowed this traversal by 4-10 %, more than such leaves gain
         // (measured: docs/notes/kernels-collapse.md).
-        const bool hit_here = test_pack(ref & ~WideBvh<W>::kLeafBit);
+        const bool hit_here = test_pack(WideBvh<W>::first_pack(ref));
         if constexpr (AnyHit)
           if (hit_here) return true;
       } else {
