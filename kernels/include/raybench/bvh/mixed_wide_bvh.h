@@ -84,6 +84,9 @@ struct MixedWideBvh : WideBvh<W> {
 template <typename TriangleLeaf>
 struct MixedWideLeaf {
   static constexpr WideLeaves kLeaves = TriangleLeaf::kLeaves;
+  // build_mixed_wide_bvh collapses with one pack per leaf (and its leaf
+  // references say so after the packs move).
+  static constexpr bool kOnePackLeaves = true;
   static constexpr bool kPrimsInPack = false;  // hits report pack slots, mapped through pack_prims
 
   struct RayData {

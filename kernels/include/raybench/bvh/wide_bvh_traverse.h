@@ -125,6 +125,9 @@ inline void push_compacted(Stack<W>& stack, simd::IntLanes<W> refs, simd::FloatL
 
 struct WideMollerTrumbore {
   static constexpr WideLeaves kLeaves = WideLeaves::kMollerTrumbore;  // what collapse_bvh2 must store
+  // Whether every leaf of the trees this test serves holds one pack: the
+  // traversal then tests a leaf's pack without the loop over several.
+  static constexpr bool kOnePackLeaves = false;
   // Whether a hit's triangle is read from the pack the test has just loaded
   // (else from pack_prims, an array of its own: a caller tracing many rays
   // maps pack slots to triangles after the traversals, see traverse_wide).
@@ -159,6 +162,7 @@ struct WideMollerTrumboreEdges : WideMollerTrumbore {
 
 struct Bvh8Watertight {
   static constexpr WideLeaves kLeaves = WideLeaves::kVertices;
+  static constexpr bool kOnePackLeaves = true;  // collapse_bvh2 makes no other
   // Triangle indices through pack slots, not in the packs: with the normals
   // the test reads six cache lines and the indices would take a seventh;
   // the same speed with a seventh less leaf memory
@@ -259,10 +263,11 @@ RAYBENCH_INLINE std::conditional_t<AnyHit, bool, Hit> traverse_wide_from(const W
         }
         return lane >= 0;
       };
-      if constexpr (Leaf::kLeaves == WideLeaves::kVertices) {
-        // One pack per leaf (collapse_bvh2): a step over several packs
-        // slowed this traversal by 4-10 %, more than such leaves gain
-        // (measured: docs/notes/kernels-collapse.md).
+      if constexpr (Leaf::kOnePackLeaves) {
+        // One pack per leaf: the watertight leaves, whose traversal a step
+        // over several packs slowed by 4-10 %, more than such leaves gain
+        // (measured: docs/notes/kernels-collapse.md), and the mixed tree's.
+        // Also one inlined leaf test per traversal, not two as below.
         const bool hit_here = test_pack(WideBvh<W>::first_pack(ref));
         if constexpr (AnyHit)
           if (hit_here) return true;
