@@ -458,13 +458,27 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
         stack.ref[stack.top] = node.child[lane];
         ++stack.top;
       };
-      if constexpr (AnyHit) {
-        for (unsigned lanes = entered; lanes; lanes &= lanes - 1) push(std::countr_zero(lanes));
-      } else {
-        for (int rank = 0; rank < 8; ++rank) {
-          const int lane = far_to_near_lane(node, plan.octant, rank);
-          if (entered >> lane & 1u) push(lane);
+      // The child visited next is entered straight away, the others pushed
+      // (in the order the pops would have visited all of them): its rays
+      // are those the pop would find within reach, which has not changed.
+      if (entered) {
+        int next;
+        if constexpr (AnyHit) {
+          next = 31 - std::countl_zero(entered);  // the highest lane, popped first
+          for (unsigned lanes = entered & ~(1u << next); lanes; lanes &= lanes - 1) push(std::countr_zero(lanes));
+        } else {
+          next = -1;
+          for (int rank = 0; rank < 8; ++rank) {
+            const int lane = far_to_near_lane(node, plan.octant, rank);
+            if (!(entered >> lane & 1u)) continue;
+            if (next >= 0) push(next);
+            next = lane;
+          }
         }
+        ref = node.child[next];
+        active = child_rays[next];
+        node_tnear = select(M::from_bits(active), p.tnear, nan_lanes());
+        continue;
       }
     }
     // Pop the next subtree some ray still reaches.
