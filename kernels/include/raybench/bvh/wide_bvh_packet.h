@@ -11,7 +11,9 @@
 // in the same order, so a ray is active in exactly the subtrees its own
 // traversal enters. Children are visited in the node's far-to-near order
 // for the packet's octant (closest hit) or in lane order (any hit), as each
-// ray alone; a popped subtree is skipped for a ray farther than its hit.
+// ray alone: the first at once, the others pushed (as Embree's coherent
+// traversal goes on into the nearest child, bvh_intersector_hybrid.cpp); a
+// popped subtree is skipped for a ray farther than its hit.
 // So every ray meets its leaves in its own order and keeps its ties.
 // Möller-Trumbore leaves test each triangle against every ray at once
 // (the pack test with the lanes' roles swapped, same operations); other
