@@ -15,9 +15,10 @@
 // traversal goes on into the nearest child, bvh_intersector_hybrid.cpp); a
 // popped subtree is skipped for a ray farther than its hit.
 // So every ray meets its leaves in its own order and keeps its ties.
-// Möller-Trumbore leaves test each triangle against every ray at once
-// (the pack test with the lanes' roles swapped, same operations); other
-// leaves ray by ray. A subtree left with kAloneAtMost active rays is traced
+// Möller-Trumbore leaves reached by most of the packet's rays test each
+// triangle against every ray at once (the pack test with the lanes' roles
+// swapped, same operations); other leaves, and those reached by fewer
+// rays, ray by ray with the single-ray pack test. A subtree left with kAloneAtMost active rays is traced
 // by each alone (traverse_wide_from), as Embree's hybrid traversal turns to
 // single rays (bvh_intersector_hybrid.cpp).
 // Grouping: a group of kPacketRays consecutive rays forms a packet of those
@@ -60,6 +61,12 @@ inline constexpr int kMinPacketRays = 3;
 // (measured with AVX-512 disabled: 1 of 8 was 2 % slower on tiled shadow
 // rays, 3 of 8 1.5 % on tiled primary rays).
 inline constexpr int kAloneAtMost = kPacketRays == 16 ? 3 : 2;
+// Active rays at a Möller-Trumbore leaf that test its packs each alone (the
+// single-ray pack test, 8 triangles at once) rather than all at once
+// (intersect_pack_rays, 16 rays at once): 12 of 16. Measured on Zen 4, tiled
+// primary and shadow rays 5-8 % faster than with every leaf tested for all
+// rays at once, 8 or 16 of 16 less so (docs/notes/kernels-packets.md).
+inline constexpr int kLeafAloneAtMost = kPacketRays * 3 / 4;
 // How alike a packet's rays must be. Measured on Sponza, Conference, the
 // terrain and the bunny (docs/notes/kernels-packets.md): from 0.99 and 2 %,
 // these made tiled shadow rays 2-18 % faster and left the others as fast;
@@ -403,36 +410,41 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
     } else if (ref & Bvh8::kLeafBit) {
       // The leaf's packs in order, as the single-ray traversal tests them.
       const std::uint32_t first = Bvh8::first_pack(ref), end = first + Bvh8::pack_count(ref);
+      const bool ray_lanes = kRayLanesLeaf<Leaf> && std::popcount(active & ~done) > kLeafAloneAtMost;
       for (std::uint32_t pack = first; pack != end; ++pack) {
-        if constexpr (kRayLanesLeaf<Leaf>) {
-          F best_t = reach, u = F::set1(0.0f), v = u;
-          alignas(64) int lane_of[kPacketRays];
-          unsigned hit_rays;
-          if constexpr (Leaf::kLeaves == WideLeaves::kMollerTrumbore)
-            hit_rays = intersect_pack_rays<AnyHit>(p, node_tnear, bvh.packs[pack], best_t, u, v, lane_of);
-          else
-            hit_rays = intersect_pack_rays<AnyHit>(p, node_tnear, bvh.edge_packs[pack], best_t, u, v, lane_of);
-          if (hit_rays) {
-            if constexpr (AnyHit) {
-              mark_occluded(hit_rays);
-            } else {
-              alignas(64) float us[kPacketRays], vs[kPacketRays];
-              best_t.storeu(tmax);
-              u.storeu(us);
-              v.storeu(vs);
-              for (unsigned lanes = hit_rays; lanes; lanes &= lanes - 1) {
-                const int i = std::countr_zero(lanes);
-                set_hit(i, pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane_of[i], tmax[i], us[i], vs[i]));
+        if (ray_lanes) {
+          if constexpr (kRayLanesLeaf<Leaf>) {
+            F best_t = reach, u = F::set1(0.0f), v = u;
+            alignas(64) int lane_of[kPacketRays];
+            unsigned hit_rays;
+            if constexpr (Leaf::kLeaves == WideLeaves::kMollerTrumbore)
+              hit_rays = intersect_pack_rays<AnyHit>(p, node_tnear, bvh.packs[pack], best_t, u, v, lane_of);
+            else
+              hit_rays = intersect_pack_rays<AnyHit>(p, node_tnear, bvh.edge_packs[pack], best_t, u, v, lane_of);
+            if (hit_rays) {
+              if constexpr (AnyHit) {
+                mark_occluded(hit_rays);
+              } else {
+                alignas(64) float us[kPacketRays], vs[kPacketRays];
+                best_t.storeu(tmax);
+                u.storeu(us);
+                v.storeu(vs);
+                for (unsigned lanes = hit_rays; lanes; lanes &= lanes - 1) {
+                  const int i = std::countr_zero(lanes);
+                  set_hit(i, pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane_of[i], tmax[i], us[i], vs[i]));
+                }
               }
+              update_bounds();
             }
-            update_bounds();
           }
         } else {
           bool any = false;
-          for (unsigned lanes = active; lanes; lanes &= lanes - 1) {
+          for (unsigned lanes = active & ~done; lanes; lanes &= lanes - 1) {
             const int i = std::countr_zero(lanes);
             TriangleHit th{};
-            const int lane = Leaf::template intersect<AnyHit>(leaf_ray[i], tmax[i], bvh, pack, th);
+            int lane;
+            if constexpr (kRayLanesLeaf<Leaf>) lane = Leaf::template intersect<AnyHit>(rays[i], tmax[i], bvh, pack, th);
+            else lane = Leaf::template intersect<AnyHit>(leaf_ray[i], tmax[i], bvh, pack, th);
             if (lane < 0) continue;
             any = true;
             if constexpr (AnyHit) {
