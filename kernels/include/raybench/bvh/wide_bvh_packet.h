@@ -397,16 +397,27 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
   for (;;) {
     if (std::popcount(active) <= kAloneAtMost) {
       // Few rays left in this subtree: each goes on alone from here.
+      unsigned occluded_rays = 0;
       for (unsigned lanes = active; lanes; lanes &= lanes - 1) {
         const int i = std::countr_zero(lanes);
         if constexpr (AnyHit) {
-          if (traverse_wide_from<true, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, Hit{})) mark_occluded(1u << i);
+          if (traverse_wide_from<true, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, Hit{})) occluded_rays |= 1u << i;
         } else {
           const Hit h = traverse_wide_from<false, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, hit_of(i));
-          if (h.hit()) set_hit(i, h);
+          if (h.hit()) {
+            set_hit(i, h);
+            reach = select(M::from_bits(1u << i), F::set1(h.t), reach);  // not reloaded from tmax (see the leaves)
+          }
         }
       }
-      update_bounds();
+      if constexpr (AnyHit) {
+        if (occluded_rays) {
+          mark_occluded(occluded_rays);
+          update_bounds();
+        }
+      } else {
+        exit = min(reach, F::set1(kLargest));
+      }
     } else if (ref & Bvh8::kLeafBit) {
       // The leaf's packs in order, as the single-ray traversal tests them.
       const std::uint32_t first = Bvh8::first_pack(ref), end = first + Bvh8::pack_count(ref);
@@ -438,7 +449,9 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
             }
           }
         } else {
-          bool any = false;
+          // Each hit narrows its ray's lane of reach in registers: reloading
+          // reach from tmax just after these scalar stores would wait for them.
+          unsigned hit_rays = 0;
           for (unsigned lanes = active & ~done; lanes; lanes &= lanes - 1) {
             const int i = std::countr_zero(lanes);
             TriangleHit th{};
@@ -446,14 +459,20 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
             if constexpr (kRayLanesLeaf<Leaf>) lane = Leaf::template intersect<AnyHit>(rays[i], tmax[i], bvh, pack, th);
             else lane = Leaf::template intersect<AnyHit>(leaf_ray[i], tmax[i], bvh, pack, th);
             if (lane < 0) continue;
-            any = true;
-            if constexpr (AnyHit) {
-              mark_occluded(1u << i);
-            } else {
+            hit_rays |= 1u << i;
+            if constexpr (!AnyHit) {
               set_hit(i, pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane, th.t, th.u, th.v));
+              reach = select(M::from_bits(1u << i), F::set1(th.t), reach);
             }
           }
-          if (any) update_bounds();
+          if (hit_rays) {
+            if constexpr (AnyHit) {
+              mark_occluded(hit_rays);
+              update_bounds();
+            } else {
+              exit = min(reach, F::set1(kLargest));
+            }
+          }
         }
       }
     } else {
