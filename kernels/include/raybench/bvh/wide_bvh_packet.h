@@ -18,9 +18,10 @@
 // Möller-Trumbore leaves reached by most of the packet's rays test each
 // triangle against every ray at once (the pack test with the lanes' roles
 // swapped, same operations); other leaves, and those reached by fewer
-// rays, ray by ray with the single-ray pack test. A subtree left with kAloneAtMost active rays is traced
-// by each alone (traverse_wide_from), as Embree's hybrid traversal turns to
-// single rays (bvh_intersector_hybrid.cpp).
+// rays, ray by ray with the single-ray pack test. With 8-ray packets, a
+// subtree left with kAloneAtMost active rays is traced by each alone
+// (traverse_wide_from), as Embree's hybrid traversal turns to single rays
+// (bvh_intersector_hybrid.cpp); 16-ray packets stay whole (measured faster).
 // Grouping: a group of kPacketRays consecutive rays forms a packet of those
 // that share the first usable ray's octant (finite, no zero direction
 // component: SlabFma's rays), point within kMinPacketCosine of its
@@ -56,11 +57,12 @@ inline constexpr int kPacketRays = 16;
 inline constexpr int kPacketRays = 8;
 #endif
 inline constexpr int kMinPacketRays = 3;
-// Active rays in a subtree that go on alone: 3 of 16 (measured: 1 of 16 was
-// 8-15 % slower on the terrain's tiled rays, the same on Sponza's), 2 of 8
-// (measured with AVX-512 disabled: 1 of 8 was 2 % slower on tiled shadow
-// rays, 3 of 8 1.5 % on tiled primary rays).
-inline constexpr int kAloneAtMost = kPacketRays == 16 ? 3 : 2;
+// Active rays in a subtree that go on alone: none of 16 (measured on Zen 4
+// once thin leaves were tested ray by ray: handing off 1, 2 or 3 of 16 was
+// 2-9 % slower on tiled rays, most on the terrain), 2 of 8 (measured with
+// AVX-512 disabled, before: 1 of 8 was 2 % slower on tiled shadow rays, 3 of
+// 8 1.5 % on tiled primary rays).
+inline constexpr int kAloneAtMost = kPacketRays == 16 ? 0 : 2;
 // Active rays at a Möller-Trumbore leaf that test its packs each alone (the
 // single-ray pack test, 8 triangles at once) rather than all at once
 // (intersect_pack_rays, 16 rays at once): 12 of 16. Measured on Zen 4, tiled
@@ -395,7 +397,7 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
     exit = min(reach, F::set1(kLargest));
   };
   for (;;) {
-    if (std::popcount(active) <= kAloneAtMost) {
+    if (kAloneAtMost > 0 && std::popcount(active) <= kAloneAtMost) {
       // Few rays left in this subtree: each goes on alone from here.
       unsigned occluded_rays = 0;
       for (unsigned lanes = active; lanes; lanes &= lanes - 1) {
