@@ -378,24 +378,29 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
     for (unsigned lanes = plan.lanes; lanes; lanes &= lanes - 1)
       leaf_ray[std::countr_zero(lanes)] = Leaf::precompute(rays[std::countr_zero(lanes)]);
   constexpr float kLargest = std::numeric_limits<float>::max();
+  F reach = F::load(tmax);  // SlabFma is not conservative: a subtree is skipped when farther than tmax
+  F exit;
+  const auto set_exit = [&] { exit = min(reach, F::set1(kLargest)); };
+  set_exit();
+  const auto update_bounds = [&] {
+    reach = F::load(tmax);
+    set_exit();
+  };
   // An occluded ray's tmax, so that it enters nothing more (any hit), and
-  // the occluded rays.
+  // the occluded rays. Any hit's reach is always tmax as a vector: marking
+  // narrows both.
   const float kDone = -std::numeric_limits<float>::infinity();
   unsigned done = 0;
   const auto mark_occluded = [&](unsigned lanes) {
     done |= lanes;
-    select(M::from_bits(lanes), F::set1(kDone), F::load(tmax)).storeu(tmax);
+    reach = select(M::from_bits(lanes), F::set1(kDone), reach);
+    reach.storeu(tmax);
+    set_exit();
   };
-  F reach = F::load(tmax);  // SlabFma is not conservative: a subtree is skipped when farther than tmax
-  F exit = min(reach, F::set1(kLargest));
   PacketStack stack;
   std::uint32_t ref = 0;
   unsigned active = plan.lanes;
   F node_tnear = select(planned, p.tnear, nan_lanes());  // tnear in the lanes active at the node, NaN in the others
-  const auto update_bounds = [&] {
-    reach = F::load(tmax);
-    exit = min(reach, F::set1(kLargest));
-  };
   for (;;) {
     if (kAloneAtMost > 0 && std::popcount(active) <= kAloneAtMost) {
       // Few rays left in this subtree: each goes on alone from here.
@@ -413,12 +418,9 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
         }
       }
       if constexpr (AnyHit) {
-        if (occluded_rays) {
-          mark_occluded(occluded_rays);
-          update_bounds();
-        }
+        if (occluded_rays) mark_occluded(occluded_rays);
       } else {
-        exit = min(reach, F::set1(kLargest));
+        set_exit();
       }
     } else if (ref & Bvh8::kLeafBit) {
       // The leaf's packs in order, as the single-ray traversal tests them.
@@ -446,8 +448,8 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
                   const int i = std::countr_zero(lanes);
                   set_hit(i, pack_lane_hit<Leaf, PackSlots>(bvh, pack, lane_of[i], tmax[i], us[i], vs[i]));
                 }
+                update_bounds();
               }
-              update_bounds();
             }
           }
         } else {
@@ -468,12 +470,8 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
             }
           }
           if (hit_rays) {
-            if constexpr (AnyHit) {
-              mark_occluded(hit_rays);
-              update_bounds();
-            } else {
-              exit = min(reach, F::set1(kLargest));
-            }
+            if constexpr (AnyHit) mark_occluded(hit_rays);
+            else set_exit();
           }
         }
       }
