@@ -1,5 +1,6 @@
 // Specification of the 8-wide batched tests (raybench/simd/): on every input,
 // the AVX2 form answers exactly as the scalar kernels, lane by lane.
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -249,6 +250,38 @@ TEST(FloatLanes, EightRowsLoadTransposedIntoEightLanesPerField) { expect_rows_tr
 #if defined(RAYBENCH_AVX512)
 TEST(FloatLanes, SixteenRowsLoadTransposedIntoSixteenLanesPerField) { expect_rows_transposed<16>(); }
 #endif
+
+// reduce_min_each / reduce_max_each: lane k is the smallest / largest lane of
+// row k, for each of the 8 rows, whichever lane holds it (every position is
+// tried), as reduce_min / reduce_max of that row alone.
+TEST(FloatLanes, EightRowsReduceEachIntoItsOwnLane) {
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<float> u(-1e6f, 1e6f);
+  for (int trial = 0; trial < 64; ++trial) {
+    simd::FloatLanes<8> rows[8];
+    float want_min[8], want_max[8];
+    for (int k = 0; k < 8; ++k) {
+      alignas(32) float row[8];
+      for (float& x : row) x = u(rng);
+      row[(trial + k) % 8] = -kInf * (k % 2 ? 1.0f : -1.0f);  // an infinity at each position in turn
+      rows[k] = simd::FloatLanes<8>::load(row);
+      want_min[k] = simd::reduce_min(rows[k]);
+      want_max[k] = simd::reduce_max(rows[k]);
+      EXPECT_EQ(want_min[k], *std::min_element(row, row + 8));
+      EXPECT_EQ(want_max[k], *std::max_element(row, row + 8));
+    }
+    alignas(32) float got_min[8], got_max[8];
+    simd::reduce_min_each(rows).storeu(got_min);
+    simd::reduce_max_each(rows).storeu(got_max);
+    for (int k = 0; k < 8; ++k) {
+      EXPECT_EQ(got_min[k], want_min[k]) << "row " << k;
+      EXPECT_EQ(got_max[k], want_max[k]) << "row " << k;
+      alignas(32) float lanes[8];
+      simd::broadcast_lane(simd::reduce_min_each(rows), k).storeu(lanes);
+      for (float x : lanes) EXPECT_EQ(x, want_min[k]) << "broadcast of lane " << k;
+    }
+  }
+}
 #endif
 
 }  // namespace

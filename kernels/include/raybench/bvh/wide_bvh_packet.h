@@ -180,6 +180,14 @@ inline unsigned load_group(const Ray* rays, int n, Packet& p) {
   return usable.mask();
 }
 
+// A packet's 8 or 16 lanes folded to 8 by min or max (for the frustum).
+inline F8 fold_min(F8 x) { return x; }
+inline F8 fold_max(F8 x) { return x; }
+#if defined(RAYBENCH_AVX512)
+inline F8 fold_min(simd::FloatLanes<16> x) { return min(simd::half_of<0>(x), simd::half_of<1>(x)); }
+inline F8 fold_max(simd::FloatLanes<16> x) { return max(simd::half_of<0>(x), simd::half_of<1>(x)); }
+#endif
+
 // Among the rays `candidates` of a group loaded into `p` (load_group), the
 // packet led by the first: those that share its octant, point within
 // kMinPacketCosine of its direction and start within max_origin_distance
@@ -209,25 +217,39 @@ inline PacketPlan plan_packet(const Ray* rays, unsigned candidates, float max_or
   PacketPlan plan;
   plan.lanes = in.mask();
   if (std::popcount(plan.lanes) < kMinPacketRays) return {};
+  // The frustum's bounds over the packet's rays, 16 reductions at once: rows
+  // 0-2 of `lows` the smallest 1/d per axis, 3-5 the smallest o/d, 6 tnear;
+  // `highs` the largest, 6 the exit bound (box_exit_bound<SlabFma>).
+  const F minus_inf = F::set1(-kInf);
+  const F exit_bound = min(p.tfar, F::set1(std::numeric_limits<float>::max()));
+  F8 lows[8], highs[8];
   for (int a = 0; a < 3; ++a) {
     const bool negative = std::signbit(rays[lead].dir[a]);
     plan.octant |= static_cast<int>(negative) << a;
     p.near_offset[a] = negative ? 3 * 8 : 0;
-    const float inv_lo = simd::reduce_min(select(in, p.inv_dir[a], inf));
-    const float inv_hi = simd::reduce_max(select(in, p.inv_dir[a], F::set1(-kInf)));
-    const float fused_lo = simd::reduce_min(select(in, p.fused[a], inf));
-    const float fused_hi = simd::reduce_max(select(in, p.fused[a], F::set1(-kInf)));
-    const float fused_abs = std::max(std::fabs(fused_lo), std::fabs(fused_hi));  // the largest |o/d|
-    const float plane_abs = std::max(std::fabs(extent.lower[a]), std::fabs(extent.upper[a]));
-    const float pad = 0x1p-20f * (plane_abs * std::max(std::fabs(inv_lo), std::fabs(inv_hi)) + fused_abs);
-    p.inv_lo[a] = F8::set1(inv_lo);
-    p.inv_hi[a] = F8::set1(inv_hi);
-    p.fused_hi[a] = F8::set1(fused_hi + pad);
-    p.fused_lo[a] = F8::set1(fused_lo - pad);
+    lows[a] = fold_min(select(in, p.inv_dir[a], inf));
+    highs[a] = fold_max(select(in, p.inv_dir[a], minus_inf));
+    lows[3 + a] = fold_min(select(in, p.fused[a], inf));
+    highs[3 + a] = fold_max(select(in, p.fused[a], minus_inf));
   }
-  p.tnear_min = F8::set1(simd::reduce_min(select(in, p.tnear, inf)));
-  const F exit_bound = min(p.tfar, F::set1(std::numeric_limits<float>::max()));  // box_exit_bound<SlabFma>
-  p.exit_max = F8::set1(simd::reduce_max(select(in, exit_bound, F::set1(-kInf))));
+  lows[6] = lows[7] = fold_min(select(in, p.tnear, inf));
+  highs[6] = highs[7] = fold_max(select(in, exit_bound, minus_inf));
+  const F8 lo = simd::reduce_min_each(lows), hi = simd::reduce_max_each(highs);
+  // pad: 2^-20 (largest |plane| * largest |1/d| + largest |o/d|) per axis, in lanes 0-2.
+  const F8 largest = max(lo.abs(), hi.abs());  // |1/d| in lanes 0-2, |o/d| in 3-5
+  const auto plane_abs = [&](int a) { return std::max(std::fabs(extent.lower[a]), std::fabs(extent.upper[a])); };
+  const F8 planes{_mm256_setr_ps(plane_abs(0), plane_abs(1), plane_abs(2), 0.0f, 0.0f, 0.0f, 0.0f, 0.0f)};
+  const F8 fused_largest = largest.permute(simd::IntLanes<8>{_mm256_setr_epi32(3, 4, 5, 3, 4, 5, 3, 4)});
+  const F8 pad = F8::set1(0x1p-20f) * (planes * largest + fused_largest);
+  for (int a = 0; a < 3; ++a) {
+    const F8 pad_a = simd::broadcast_lane(pad, a);
+    p.inv_lo[a] = simd::broadcast_lane(lo, a);
+    p.inv_hi[a] = simd::broadcast_lane(hi, a);
+    p.fused_hi[a] = simd::broadcast_lane(hi, 3 + a) + pad_a;
+    p.fused_lo[a] = simd::broadcast_lane(lo, 3 + a) - pad_a;
+  }
+  p.tnear_min = simd::broadcast_lane(lo, 6);
+  p.exit_max = simd::broadcast_lane(hi, 6);
   return plan;
 }
 
