@@ -282,6 +282,19 @@ TEST(FloatLanes, EightRowsReduceEachIntoItsOwnLane) {
     }
   }
 }
+#if defined(RAYBENCH_AVX512)
+TEST(FloatLanes, AnyOfSixteenLanesBroadcastsIntoEight) {
+  alignas(64) float values[16];
+  for (int i = 0; i < 16; ++i) values[i] = static_cast<float>(i) - 7.5f;
+  values[5] = -0.0f;
+  const simd::FloatLanes<16> x = simd::FloatLanes<16>::load(values);
+  for (int k = 0; k < 16; ++k) {
+    alignas(32) float lanes[8];
+    simd::broadcast_lane8(x, k).storeu(lanes);
+    for (float v : lanes) EXPECT_EQ(std::bit_cast<std::uint32_t>(v), std::bit_cast<std::uint32_t>(values[k])) << "lane " << k;
+  }
+}
+#endif
 #endif
 
 }  // namespace

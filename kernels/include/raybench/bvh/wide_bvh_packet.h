@@ -114,8 +114,6 @@ struct Packet {
   int near_offset[3];  // the shared octant's entry planes (RayLanes::near_offset)
   F8 inv_lo[3], inv_hi[3], fused_hi[3], fused_lo[3];
   F8 tnear_min, exit_max;
-  // inv_dir and fused lane by lane, for a node tested ray by ray.
-  alignas(64) float inv_dir_of[3][kPacketRays], fused_of[3][kPacketRays];
 };
 
 // A glance at a group of rays[0..n) (n <= kPacketRays), in scalar code: the
@@ -171,8 +169,6 @@ inline unsigned load_group(const Ray* rays, int n, Packet& p) {
     p.dir[a] = fields[4 + a];
     p.inv_dir[a] = F::set1(1.0f) / p.dir[a];  // Slab::precompute's 1/d, rounded alike
     p.fused[a] = p.org[a] * p.inv_dir[a];
-    p.inv_dir[a].storeu(p.inv_dir_of[a]);
-    p.fused[a].storeu(p.fused_of[a]);
     usable = usable & (p.org[a].abs() < inf) & (p.dir[a].abs() < inf) & (p.inv_dir[a].abs() < inf);
   }
   p.tnear = fields[3];
@@ -183,9 +179,12 @@ inline unsigned load_group(const Ray* rays, int n, Packet& p) {
 // A packet's 8 or 16 lanes folded to 8 by min or max (for the frustum).
 inline F8 fold_min(F8 x) { return x; }
 inline F8 fold_max(F8 x) { return x; }
+// Lane `i` of a packet's 8 or 16 in each of 8 lanes.
+inline F8 lane_of(F8 x, int i) { return simd::broadcast_lane(x, i); }
 #if defined(RAYBENCH_AVX512)
 inline F8 fold_min(simd::FloatLanes<16> x) { return min(simd::half_of<0>(x), simd::half_of<1>(x)); }
 inline F8 fold_max(simd::FloatLanes<16> x) { return max(simd::half_of<0>(x), simd::half_of<1>(x)); }
+inline F8 lane_of(simd::FloatLanes<16> x, int i) { return simd::broadcast_lane8(x, i); }
 #endif
 
 // Among the rays `candidates` of a group loaded into `p` (load_group), the
@@ -300,8 +299,8 @@ inline unsigned children_ray_by_ray(const Packet& p, const Ray* rays, const floa
     const int i = std::countr_zero(active);
     RayLanes<8> rl;
     for (int a = 0; a < 3; ++a) {
-      rl.inv_dir[a] = F8::set1(p.inv_dir_of[a][i]);
-      rl.fused_near[a] = rl.fused_far[a] = F8::set1(p.fused_of[a][i]);
+      rl.inv_dir[a] = lane_of(p.inv_dir[a], i);
+      rl.fused_near[a] = rl.fused_far[a] = lane_of(p.fused[a], i);
       rl.near_offset[a] = p.near_offset[a];
     }
     rl.tnear = rays[i].tnear;
