@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <iostream>
 #include <limits>
 
 #include <benchmark/benchmark.h>
@@ -15,6 +14,7 @@
 #include "accuracy/judge.h"
 #include "accuracy/prim_raysets.h"
 #include "io/error.h"
+#include "io/interrupt.h"
 #include "measure/gbench.h"
 #include "results/metadata.h"
 #include "io/npy.h"
@@ -278,7 +278,7 @@ void run_family(const KernelAccuracyOptions& options, std::vector<AccuracyRow>& 
     bool any = false;
     for_each_variant<typename Family::Variants>([&](auto v) { any = any || wanted(decltype(v)::name); });
     if (!any) continue;
-    std::cerr << fmt::format("raybench: {} {}: judging {} rays\n", set.scene, set.rayset, set.rays.size());
+    print_stderr_line(fmt::format("raybench: {} {}: judging {} rays", set.scene, set.rayset, set.rays.size()));
     if (!options.rays_dir.empty()) store(set, options);
     std::vector<Truth> truth(set.rays.size());
     for (std::size_t i = 0; i < set.rays.size(); ++i) truth[i] = Family::truth(set.rays[i], set.prims[i]);

@@ -332,7 +332,7 @@ int run(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
-    std::cerr << "raybench: error: " << raybench::printable(e.what()) << " (see 'raybench --help')" << std::endl;
+    raybench::print_stderr_line("raybench: error: " + raybench::printable(e.what()) + " (see 'raybench --help')");
     return 2;
   }
 
@@ -613,13 +613,13 @@ int main(int argc, char** argv) {
     raybench::install_interrupt_handler();  // SIGINT/SIGTERM: temporary files removed, exit 130/143 (interrupt.h)
     return raybench::run(argc, argv);
   } catch (const raybench::InputError& e) {
-    std::cerr << "raybench: error: " << raybench::printable(e.what()) << std::endl;
+    raybench::print_stderr_line("raybench: error: " + raybench::printable(e.what()));
     return 2;
   } catch (const std::bad_alloc&) {
-    std::cerr << "raybench: error: out of memory" << std::endl;
+    raybench::print_stderr_line("raybench: error: out of memory");
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "raybench: error: " << raybench::printable(e.what()) << std::endl;
+    raybench::print_stderr_line("raybench: error: " + raybench::printable(e.what()));
     return 2;
   }
 }

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstring>
+#include <iostream>
 #include <pthread.h>
 #include <stdexcept>
 #include <unistd.h>
@@ -108,6 +109,13 @@ void set_interrupt_message(const std::string& line) {
   m.size = std::min(line.size(), sizeof m.text);
   std::memcpy(m.text, line.data(), m.size);
   g_current.store(next, std::memory_order_release);
+}
+
+void print_stderr_line(const std::string& line) {
+  const std::string whole = line + '\n';
+  const SignalsDeferred deferred;
+  std::cerr.flush();
+  write_all(whole.data(), whole.size());
 }
 
 RemoveOnInterrupt::RemoveOnInterrupt(const std::string& path) : slot_(-1) {

@@ -30,6 +30,12 @@ void install_interrupt_handler();
 // handler cannot format. Call it on the main thread.
 void set_interrupt_message(const std::string& line);
 
+// Writes `line` and a newline to stderr in one piece, with SIGINT and SIGTERM
+// deferred meanwhile: the handler's own line then always starts a line of its
+// own, never the tail of a status line cut in two (std::cerr writes each `<<`
+// separately). Every status and error line of raybench goes through it.
+void print_stderr_line(const std::string& line);
+
 // A file to remove if a signal ends the process while this object lives:
 // a temporary file being written, or a probe. Registering does not create
 // the file and unregistering does not remove it. At most 16 at once.

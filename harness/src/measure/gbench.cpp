@@ -6,12 +6,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <iostream>
 #include <numeric>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
+#include "io/interrupt.h"
 #include "scene/random.h"
 
 namespace raybench {
@@ -74,9 +74,8 @@ void CollectingReporter::ReportRuns(const std::vector<Run>& runs) {
     const std::string& name = runs.front().run_name.function_name;
     const auto it = samples_.find(name);
     const double m = it == samples_.end() ? std::nan("") : median(it->second);
-    std::cerr << fmt::format("raybench:   [{}/{}] {}: {:.3g} {} (median of {})", ++done_, total_, name, m, unit_,
-                             it == samples_.end() ? 0 : it->second.size())
-              << std::endl;
+    print_stderr_line(fmt::format("raybench:   [{}/{}] {}: {:.3g} {} (median of {})", ++done_, total_, name, m, unit_,
+                                    it == samples_.end() ? 0 : it->second.size()));
   }
 }
 

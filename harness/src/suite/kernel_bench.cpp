@@ -305,7 +305,7 @@ std::vector<KernelResult> run_kernel_benchmarks(const KernelBenchOptions& option
   // Where the results go is checked before minutes of timing, not after.
   check_writable(options.out_csv);
   if (!options.out_json.empty()) check_writable(options.out_json);
-  std::cerr << "raybench: making inputs (" << options.pairs << " pairs per family and input)" << std::endl;
+  print_stderr_line(fmt::format("raybench: making inputs ({} pairs per family and input)", options.pairs));
   std::vector<Case> all;
   add_family<TriangleFamily>(all, options.pairs);
   add_family<BoxFamily>(all, options.pairs);

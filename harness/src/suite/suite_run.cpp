@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <iostream>
 #include <map>
 #include <memory>
 #include <new>
@@ -41,7 +40,7 @@
 namespace raybench {
 namespace {
 
-void progress(const std::string& line) { std::cerr << "raybench: " << line << std::endl; }
+void progress(const std::string& line) { print_stderr_line("raybench: " + line); }
 
 // The build line's "4.0 MiB in huge pages" (build_timing.h's huge_page_bytes).
 std::string describe_huge_pages(const std::optional<std::size_t>& bytes) {
