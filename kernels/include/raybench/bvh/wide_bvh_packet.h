@@ -187,6 +187,14 @@ inline F8 fold_max(simd::FloatLanes<16> x) { return max(simd::half_of<0>(x), sim
 inline F8 lane_of(simd::FloatLanes<16> x, int i) { return simd::broadcast_lane8(x, i); }
 #endif
 
+// Asks for every 64-byte cache line of `x` ahead of its use: a hint, it
+// changes no result.
+template <typename T>
+inline void prefetch_lines(const T& x) {
+  const char* bytes = reinterpret_cast<const char*>(&x);
+  for (std::size_t line = 0; line < sizeof(T); line += 64) __builtin_prefetch(bytes + line);
+}
+
 // Among the rays `candidates` of a group loaded into `p` (load_group), the
 // packet led by the first: those that share its octant, point within
 // kMinPacketCosine of its direction and start within max_origin_distance
@@ -550,6 +558,12 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
         else child_entry[lane].storeu(stack.entry[stack.top]);
         stack.ref[stack.top] = node.child[lane];
         ++stack.top;
+        // Popped only after the nearer subtrees: its node (or its leaf's
+        // first pack) is fetched meanwhile, as the tree outgrows L2
+        // (docs/notes/kernels-packets.md, "prefetching pushed children").
+        const std::uint32_t child = node.child[lane];
+        if (!(child & Bvh8::kLeafBit)) prefetch_lines(bvh.nodes[child]);
+        else if constexpr (Leaf::kLeaves == WideLeaves::kMollerTrumbore) prefetch_lines(bvh.packs[Bvh8::first_pack(child)]);
       };
       // The child visited next is entered straight away, the others pushed
       // (in the order the pops would have visited all of them): its rays
