@@ -292,12 +292,12 @@ inline FloatLanes<8> half_of(FloatLanes<16> x) {
   return {_mm256_castpd_ps(_mm512_maskz_extractf64x4_pd(0xff, _mm512_castps_pd(x.v), Half))};
 }
 inline float reduce_min(FloatLanes<16> x) { return reduce_min(min(half_of<0>(x), half_of<1>(x))); }
+inline float reduce_max(FloatLanes<16> x) { return reduce_max(max(half_of<0>(x), half_of<1>(x))); }
 // Lane `k` of x in each of 8 lanes (one permute, zero-masked under a full
 // mask for GCC 12's sake as above).
 inline FloatLanes<8> broadcast_lane8(FloatLanes<16> x, int k) {
   return half_of<0>(FloatLanes<16>{_mm512_maskz_permutexvar_ps(0xffff, _mm512_set1_epi32(k), x.v)});
 }
-inline float reduce_max(FloatLanes<16> x) { return reduce_max(max(half_of<0>(x), half_of<1>(x))); }
 
 // Register j holds row j in its low 256 bits and row j + 8 in its high ones,
 // so the 8-lane transpose's first two steps run on both halves at once; one
