@@ -21,9 +21,11 @@ scorecard (machine_scorecard.render_coherent_card) of a run of meshes/coherent.t
   agreeing (>= 99.9 %), for every one of our backends in the run (the table's columns give our
   best backend's; the target line names the worst row and backend).
 Ratios are within the run, so they travel between machines; the run's metadata names the
-machine. When the CSV has each median's min and max over the repetitions, every ratio gets its
-range too (ours at its slowest / Embree at its fastest, and the reverse), and a ratio below a
-target is said to be within that noise or beyond it; the verdict stays the median's. Build times
+machine. In a run timed in rounds (metadata timing = "rounds") a ratio is the median of the
+per-round ratios, as raybench's own ratio_to_embree (docs/method.md), and its range their lowest
+and highest; in an older run, the ratio of the medians, and with each median's min and max over
+the repetitions its range (ours at its slowest / Embree at its fastest, and the reverse). A ratio
+below a target is said to be within that noise or beyond it; the verdict stays the median's. Build times
 likewise, from their min and max over the timing rounds (a build ratio above 1.0, or a build no
 faster with more threads, is said to be within their range or beyond it). How noisy the run was
 is said from Embree's own rates: their spread over the repetitions, (max - min) / median, per row.
@@ -80,6 +82,57 @@ def ratio_range(ours, theirs, column="mrays_s"):
     return lo / their_hi, hi / their_lo
 
 
+def attach_round_samples(rows, meta, source):
+    """Gives every row its rate samples in round order (`samples`, from mrays_s_samples) when the run
+    pairs them by round (metadata timing = "rounds": sample i of every row of a scene is from round
+    i, docs/method.md); rows of other runs keep none. InputError on a sample that is not a positive
+    number. Returns rows."""
+    if (meta or {}).get("timing") != "rounds":
+        return rows
+    for r in rows:
+        text = r.get("mrays_s_samples")
+        if not text:
+            continue
+        try:
+            samples = [float(s) for s in text.split(";")]
+        except ValueError:
+            samples = []
+        if not samples or not all(s > 0 for s in samples):
+            raise InputError(source, f"{r['scene']}/{r['rayset']}/{r['backend']}/threads {r['threads']}: "
+                                     f"mrays_s_samples must be positive numbers separated by ';', not {text!r}")
+        r["samples"] = samples
+    return rows
+
+
+def paired_ratios(ours, theirs):
+    """ours / theirs round by round (sample i over sample i), or None unless both rows carry samples
+    from the same rounds (attach_round_samples)."""
+    a, b = ours.get("samples"), theirs.get("samples")
+    if not a or not b or len(a) != len(b):
+        return None
+    return [x / y for x, y in zip(a, b)]
+
+
+def ratio_with_range(ours, theirs):
+    """(ours / theirs, its (lowest, highest)), as docs/method.md defines a ratio: in a run paired by
+    round, the median of the per-round ratios and their extremes, so that noise hitting a whole
+    round cancels; otherwise the ratio of the medians and ratio_range (None without min and max)."""
+    paired = paired_ratios(ours, theirs)
+    if paired:
+        return statistics.median(paired), (min(paired), max(paired))
+    return ours["mrays_s"] / theirs["mrays_s"], ratio_range(ours, theirs)
+
+
+def range_sentence(rows, theirs="Embree"):
+    """What a ratio and its range in brackets are in this run's scorecard; `theirs`: what ours is
+    compared with."""
+    if any(r.get("samples") for r in rows):
+        return (f"A ratio is the median over the timing rounds of ours / {theirs} in the same round (docs/method.md), "
+                "its range in brackets the lowest and highest of those per-round ratios")
+    return (f"A ratio's range in brackets: ours at its slowest over the repetitions against {theirs} at its fastest, "
+            "and the reverse")
+
+
 def one_per_scene(lines):
     """The lines with a build ratio, one per scene: the rows of its ray sets share its build."""
     return list({x["scene"]: x for x in lines if x["build_ratio"] is not None}.values())
@@ -106,11 +159,11 @@ def scorecard(rows, threads=1):
         lines.append({
             "scene": scene, "rayset": rayset,
             "embree": embree_name, "embree_mrays": embree["mrays_s"],
-            "best": best_name, "best_mrays": best["mrays_s"], "ratio": best["mrays_s"] / embree["mrays_s"],
-            "ratio_range": ratio_range(best, embree),
+            "best": best_name, "best_mrays": best["mrays_s"],
+            **dict(zip(("ratio", "ratio_range"), ratio_with_range(best, embree))),
             "watertight": wt_name,
-            "watertight_ratio": wt["mrays_s"] / default["mrays_s"] if wt and default else None,
-            "watertight_range": ratio_range(wt, default) if wt and default else None,
+            **dict(zip(("watertight_ratio", "watertight_range"),
+                       ratio_with_range(wt, default) if wt and default and default["mrays_s"] else (None, None))),
             "build_ratio": builder["build_ms"] / default["build_ms"] if builder and default and default["build_ms"] else None,
             "build_range": ratio_range(builder, default, "build_ms") if builder and default else None,
             **{k: builder.get(k) if builder else None for k in ("build_ms", "build_ms_min", "build_ms_max")},
@@ -119,7 +172,7 @@ def scorecard(rows, threads=1):
                                    default=None),
             "worst_same_triangle": min(((same_triangle(r), b) for b, r in ours.items() if same_triangle(r) is not None),
                                        default=None),
-            "each": {b: r["mrays_s"] / embree["mrays_s"] for b, r in ours.items()},
+            "each": {b: ratio_with_range(r, embree)[0] for b, r in ours.items()},
         })
     return lines
 
@@ -324,8 +377,7 @@ def render(lines, meta, source, rows=(), plot=None):
                    f"{with_range(x['build_ratio'], x['build_range'])} | {fmt(None if x['agree_hit'] is None else 100 * x['agree_hit'], '.3f', ' %')} | "
                    f"{fmt(None if x['same_triangle'] is None else 100 * x['same_triangle'], '.2f', ' %')} |")
     if any(x["ratio_range"] for x in lines):
-        out += ["", "A ratio's range in brackets: ours at its slowest over the repetitions against Embree at its fastest, "
-                "and the reverse; for build times, our fastest build against Embree's slowest, and the reverse."]
+        out += ["", range_sentence(rows) + "; for build times, our fastest build against Embree's slowest, and the reverse."]
     noise = run_noise(rows)
     if noise:
         out += ["", noise]
@@ -433,8 +485,8 @@ def write_scorecard(results, sets, out, plot, machine_dir):
     """Reads the run, writes the scorecard (stdout without `out`), its picture, and with `machine_dir`
     the index; returns the Markdown's path or None."""
     import machine_scorecard
-    rows = read_table(results, REQUIRED, NUMERIC)
     meta = read_meta(results)
+    rows = attach_round_samples(read_table(results, REQUIRED, NUMERIC), meta, results)
     if machine_dir:
         if not meta:
             raise InputError(results, "no metadata beside it (.meta.toml): cannot name the machine class")

@@ -256,7 +256,8 @@ def toml_value(v):
 def write_run(directory, name, rows, meta):
     """A results CSV (with min/max columns when any row has them) and, unless meta is None, its .meta.toml."""
     path = os.path.join(directory, name + ".csv")
-    columns = COLUMNS + [c for c in ("mrays_s_min", "mrays_s_max", "build_ms_min", "build_ms_max") if any(c in r for r in rows)]
+    columns = COLUMNS + [c for c in ("mrays_s_min", "mrays_s_max", "build_ms_min", "build_ms_max", "mrays_s_samples")
+                         if any(c in r for r in rows)]
     with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=columns)
         w.writeheader()
@@ -522,6 +523,29 @@ class MachineScorecard(unittest.TestCase):
         self.assertEqual(command[command.index("--threads") + 1], "1,2")
         self.assertRegex(command[command.index("--out") + 1], r"/(intel|amd|unknown)-family\d+-model\d+-run\.csv$")
         self.assertEqual(command[-2:], ["--scene", "bunny"])
+
+    def test_a_run_timed_in_rounds_gives_each_ratio_as_the_median_of_its_per_round_ratios(self):
+        # a primary: bvh8 16, 12, 8 against embree 10, 8, 5 (a slower third round hitting both). Per
+        # round 1.6, 1.5, 1.6: paired, 1.60 (1.50–1.60); the medians' ratio would read 12 / 8 = 1.50 and
+        # its range 8 / 10 to 16 / 5 (0.80–3.20), comparing Embree's quiet rounds with bvh8's busy ones.
+        rows = issue33_run()
+        for r in rows:
+            if (r["scene"], r["rayset"], r["threads"]) == ("a", "primary", 1) and r["backend"] in ("embree", "bvh8"):
+                samples = [16.0, 12.0, 8.0] if r["backend"] == "bvh8" else [10.0, 8.0, 5.0]
+                r.update(mrays_s=samples[1], mrays_s_min=min(samples), mrays_s_max=max(samples),
+                         mrays_s_samples=";".join(map(str, samples)))
+        with tempfile.TemporaryDirectory() as d:
+            paired = scorecard_cli(write_run(d, "paired", rows, {**INTEL, "timing": "rounds"}), "--no-plot").stdout
+            unpaired = scorecard_cli(write_run(d, "unpaired", rows, INTEL), "--no-plot").stdout
+            bad = scorecard_cli(write_run(d, "bad", [{**r, "mrays_s_samples": "12;x"} if "mrays_s_samples" in r else r
+                                                     for r in rows], {**INTEL, "timing": "rounds"}), "--no-plot")
+        self.assertIn("| a | primary | 1.60 (1.50–1.60) |", paired)
+        # Rows without samples (every other pair here) keep the medians' ratio and the extremes' range.
+        self.assertIn("| a | diffuse | 1.50 (1.34–1.67) |", paired)
+        # A run whose samples are not paired by round (no timing = "rounds"): the medians' ratio.
+        self.assertIn("| a | primary | 1.50 (0.80–3.20) |", unpaired)
+        self.assertEqual(bad.returncode, 2)
+        self.assertIn("a/primary/embree/threads 1: mrays_s_samples must be positive numbers", bad.stderr)
 
     def test_bad_input_is_one_line_and_exit_2(self):
         with tempfile.TemporaryDirectory() as d:

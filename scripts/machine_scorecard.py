@@ -7,7 +7,7 @@ compress instructions), so each class gets its own scorecard, results/scorecards
 from a full run committed beside it as <class>-run.csv (+ .meta.toml).
 
 Issue 33's targets, one thread unless said, ratios within the run, each row's ratio with its range
-over the repetitions (bvh_scorecard.ratio_range):
+over the repetitions (bvh_scorecard.ratio_with_range: paired by round in a run timed in rounds):
 - `bvh8` >= 1.05 x `embree` on every scene x ray kind (primary, diffuse, shadow, uniform), and
   >= 1.0 x Embree's best of `embree` and `embree:high`;
 - our best >= 1.30 x Embree's best as a geometric mean over the primary, diffuse and shadow rows,
@@ -36,7 +36,7 @@ import os
 import re
 import tomllib
 
-from bvh_scorecard import is_ours, is_watertight, ratio_range, run_noise, verdict
+from bvh_scorecard import is_ours, is_watertight, range_sentence, ratio_range, ratio_with_range, run_noise, verdict
 from report import InputError, geometric_mean, read_meta
 
 RAY_KINDS = ("primary", "diffuse", "shadow", "uniform")
@@ -123,10 +123,11 @@ def fastest(backends, names):
 
 
 def ratio(ours, theirs):
-    """(ours / theirs, its range over the repetitions), or (None, None) without either row."""
+    """(ours / theirs, its range over the repetitions: bvh_scorecard.ratio_with_range, paired by
+    round where the run is), or (None, None) without either row."""
     if ours is None or theirs is None or not theirs["mrays_s"]:
         return None, None
-    return ours["mrays_s"] / theirs["mrays_s"], ratio_range(ours, theirs)
+    return ratio_with_range(ours, theirs)
 
 
 def rows_of(rows, threads=1):
@@ -414,8 +415,7 @@ def render(rows, meta, source, plot=None):
         out.append(f"| {x['scene']} | {x['rayset']} | {fmt_ratio(x['bvh8_embree'], x['bvh8_embree_range'])} | "
                    f"{fmt_ratio(x['bvh8_best'], x['bvh8_best_range'])} | {x['best']} | "
                    f"{fmt_ratio(x['best_best'], x['best_best_range'])} | {fmt_ratio(x['wt_embree'], x['wt_embree_range'])} |")
-    out += ["", "A ratio's range in brackets: ours at its slowest over the repetitions against Embree at its fastest, "
-            "and the reverse. \"Within noise\": a row below its target whose range reaches it."]
+    out += ["", range_sentence(rows) + ". \"Within noise\": a row below its target whose range reaches it."]
     noise = run_noise(rows, kinds=RAY_KINDS)
     if noise:
         out += ["", noise]
@@ -461,7 +461,7 @@ def render_coherent_card(rows, meta, source, plot=None):
     out = header(meta, source, "coherent rays, our packets against Embree's packets and streams (issue 32)")
     if plot:
         out += ["", f"![ours against Embree's best coherent mode and against embree, per scene and ray kind]({plot})"]
-    return out + render_coherent(rows)
+    return out + render_coherent(rows) + ["", range_sentence(rows, "the row compared with") + "."]
 
 
 def summary_comment(facts):
