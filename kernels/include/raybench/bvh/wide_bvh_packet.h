@@ -577,13 +577,17 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
         if constexpr (AnyHit) {
           next = 31 - std::countl_zero(entered);  // the highest lane, popped first
           for (unsigned lanes = entered & ~(1u << next); lanes; lanes &= lanes - 1) push(std::countr_zero(lanes));
+        } else if ((entered & (entered - 1)) == 0) {
+          next = std::countr_zero(entered);  // one child entered: no order to read
         } else {
+          // Far to near, up to the last entered child: the nearest, visited next.
           next = -1;
-          for (int rank = 0; rank < 8; ++rank) {
-            const int lane = far_to_near_lane(node, plan.octant, rank);
-            if (!(entered >> lane & 1u)) continue;
+          for (unsigned left = entered, rank = 0; left; ++rank) {
+            const int lane = far_to_near_lane(node, plan.octant, static_cast<int>(rank));
+            if (!(left >> lane & 1u)) continue;
             if (next >= 0) push(next);
             next = lane;
+            left &= ~(1u << lane);
           }
         }
         ref = node.child[next];
