@@ -735,8 +735,10 @@ TEST(WideBvhTraversal, AnyHitPushesTheEnteredChildrenInLaneOrderAboveWhatIsThere
   for (unsigned mask = 0; mask < 256; ++mask) {
     wide_bvh_detail::Stack<8> stack;
     stack.top = 3;
+    for (int i = 0; i < 3; ++i) stack.ref[i] = 7 + static_cast<std::uint32_t>(i);
     wide_bvh_detail::push_in_lane_order(stack, node, mask);
     ASSERT_EQ(stack.top, 3 + __builtin_popcount(mask)) << mask;
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(stack.ref[i], 7u + static_cast<std::uint32_t>(i)) << "mask " << mask;
     for (int i = 3, lane = 0; i < stack.top; ++i, ++lane) {
       while (!(mask >> lane & 1u)) ++lane;
       EXPECT_EQ(stack.ref[i], node.child[lane]) << "mask " << mask;

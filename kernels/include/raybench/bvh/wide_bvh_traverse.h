@@ -28,8 +28,9 @@
 // whose box the box test enters; with the watertight leaves and a
 // conservative box test no ray leaks through the tree (as bvh2:watertight).
 // A popped subtree is skipped only when it is farther than the current hit.
-// With AVX-512VL the leaf tests compare into mask registers (same answers);
-// the node test and the ordered push stay AVX2's, which measured faster.
+// With AVX-512VL the leaf tests compare into mask registers (same answers)
+// and any hit's push compresses in a register; the node test and the
+// ordered push stay AVX2's, which measured faster.
 // measured (child orders, pushes, inlining, AVX-512; tried and dropped):
 // docs/notes/kernels-wide-traversal.md
 #pragma once
@@ -61,12 +62,24 @@ struct Stack {
 };
 
 // Pushes the children of `node` in `lanes` (bit i: lane i) in lane order,
-// refs only (any hit: its interval never shrinks). The AVX2 traversal pushes
-// so too, as Embree does (bvh_traverser1.h): for the two or three children a
-// shadow ray usually enters, it is faster than a compacted SIMD push
+// refs only (any hit: its interval never shrinks), as Embree does
+// (bvh_traverser1.h). With AVX-512VL, 8 wide: one compress of the 8 refs in
+// a register (vpcompressd; never its memory form, microcoded on AMD) and one
+// store of 8 into the stack's slack, no branch per child; else child by
+// child, which for the two or three children a shadow ray usually enters
+// measured faster than AVX2's compacted push through a permute table
 // (measured: docs/notes/kernels-wide-traversal.md).
 template <int W>
 inline void push_in_lane_order(Stack<W>& stack, const WideNode<W>& node, unsigned lanes) {
+#if defined(RAYBENCH_AVX512)
+  if constexpr (W == 8) {
+    const __m256i refs = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(node.child));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.ref + stack.top),
+                        _mm256_maskz_compress_epi32(static_cast<__mmask8>(lanes), refs));
+    stack.top += __builtin_popcount(lanes);
+    return;
+  }
+#endif
   for (; lanes; lanes &= lanes - 1) stack.ref[stack.top++] = node.child[__builtin_ctz(lanes)];
 }
 
