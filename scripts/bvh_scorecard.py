@@ -40,8 +40,8 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from report import (DPI, InputError, draw_grouped_bars, figure_width, geometric_mean, pyplot, read_meta,  # noqa: E402
-                    read_table, rotate_if_crowded, wrap_title)
+from report import (DPI, InputError, draw_grouped_bars, figure_width, geometric_mean, pyplot, rate_samples,  # noqa: E402
+                    read_meta, read_table, rotate_if_crowded, wrap_title)
 
 RAYSETS = ("primary", "diffuse", "shadow")
 REQUIRED = ["scene", "rayset", "backend", "threads", "rays", "mrays_s", "build_ms", "hit_rate", "agree_hit",
@@ -83,24 +83,14 @@ def ratio_range(ours, theirs, column="mrays_s"):
 
 
 def attach_round_samples(rows, meta, source):
-    """Gives every row its rate samples in round order (`samples`, from mrays_s_samples) when the run
-    pairs them by round (metadata timing = "rounds": sample i of every row of a scene is from round
-    i, docs/method.md); rows of other runs keep none. InputError on a sample that is not a positive
-    number. Returns rows."""
+    """Gives every row its rate samples in round order (`samples`, report.rate_samples) when the
+    run pairs them by round (metadata timing = "rounds": sample i of every row of a scene is from
+    round i, docs/method.md); rows of other runs keep none. Returns rows."""
     if (meta or {}).get("timing") != "rounds":
         return rows
     for r in rows:
-        text = r.get("mrays_s_samples")
-        if not text:
-            continue
-        try:
-            samples = [float(s) for s in text.split(";")]
-        except ValueError:
-            samples = []
-        if not samples or not all(s > 0 for s in samples):
-            raise InputError(source, f"{r['scene']}/{r['rayset']}/{r['backend']}/threads {r['threads']}: "
-                                     f"mrays_s_samples must be positive numbers separated by ';', not {text!r}")
-        r["samples"] = samples
+        if r.get("mrays_s_samples"):
+            r["samples"] = rate_samples(source, r)
     return rows
 
 
@@ -116,7 +106,10 @@ def paired_ratios(ours, theirs):
 def ratio_with_range(ours, theirs):
     """(ours / theirs, its (lowest, highest)), as docs/method.md defines a ratio: in a run paired by
     round, the median of the per-round ratios and their extremes, so that noise hitting a whole
-    round cancels; otherwise the ratio of the medians and ratio_range (None without min and max)."""
+    round cancels; otherwise the ratio of the medians and ratio_range (None without min and max).
+    (None, None) without either row or with no rate of theirs."""
+    if ours is None or theirs is None or not theirs["mrays_s"]:
+        return None, None
     paired = paired_ratios(ours, theirs)
     if paired:
         return statistics.median(paired), (min(paired), max(paired))
@@ -156,14 +149,13 @@ def scorecard(rows, threads=1):
         wt_name, wt = max(watertight.items(), key=lambda kv: kv[1]["mrays_s"]) if watertight else (None, None)
         default = backends.get("embree")
         builder = ours.get("bvh8") or ours.get("bvh2")
+        ratio, ratio_span = ratio_with_range(best, embree)
+        wt_ratio, wt_span = ratio_with_range(wt, default)
         lines.append({
             "scene": scene, "rayset": rayset,
             "embree": embree_name, "embree_mrays": embree["mrays_s"],
-            "best": best_name, "best_mrays": best["mrays_s"],
-            **dict(zip(("ratio", "ratio_range"), ratio_with_range(best, embree))),
-            "watertight": wt_name,
-            **dict(zip(("watertight_ratio", "watertight_range"),
-                       ratio_with_range(wt, default) if wt and default and default["mrays_s"] else (None, None))),
+            "best": best_name, "best_mrays": best["mrays_s"], "ratio": ratio, "ratio_range": ratio_span,
+            "watertight": wt_name, "watertight_ratio": wt_ratio, "watertight_range": wt_span,
             "build_ratio": builder["build_ms"] / default["build_ms"] if builder and default and default["build_ms"] else None,
             "build_range": ratio_range(builder, default, "build_ms") if builder and default else None,
             **{k: builder.get(k) if builder else None for k in ("build_ms", "build_ms_min", "build_ms_max")},

@@ -122,14 +122,6 @@ def fastest(backends, names):
     return max(present, key=lambda kv: kv[1]["mrays_s"]) if present else (None, None)
 
 
-def ratio(ours, theirs):
-    """(ours / theirs, its range over the repetitions: bvh_scorecard.ratio_with_range, paired by
-    round where the run is), or (None, None) without either row."""
-    if ours is None or theirs is None or not theirs["mrays_s"]:
-        return None, None
-    return ratio_with_range(ours, theirs)
-
-
 def rows_of(rows, threads=1):
     """Per (scene, ray kind) at `threads`, in the run's order: the ratios of issue 33's targets."""
     by = {}
@@ -150,7 +142,7 @@ def rows_of(rows, threads=1):
         for key, (a, b) in {"bvh8_embree": (backends.get("bvh8"), embree),
                             "bvh8_best": (backends.get("bvh8"), best_embree),
                             "best_best": (best, best_embree), "wt_embree": (wt, embree)}.items():
-            line[key], line[key + "_range"] = ratio(a, b)
+            line[key], line[key + "_range"] = ratio_with_range(a, b)
         lines.append(line)
     return lines
 
@@ -284,10 +276,10 @@ def coherent_rows_of(rows, threads=1):
             best_name, best = fastest(backends, ours)
             embree_name, embree_best = fastest(backends, [b for b in backends if is_embree_coherent(b)])
             line.update(best=best_name, best_embree=embree_name)
-            line["coh_coh"], line["coh_coh_range"] = ratio(best, embree_best)
-            line["coh_embree"], line["coh_embree_range"] = ratio(best, backends.get("embree"))
+            line["coh_coh"], line["coh_coh_range"] = ratio_with_range(best, embree_best)
+            line["coh_embree"], line["coh_embree_range"] = ratio_with_range(best, backends.get("embree"))
         else:
-            pairs = [(b, ratio(backends[b], backends.get(single_ray_twin(b)))) for b in ours]
+            pairs = [(b, ratio_with_range(backends[b], backends.get(single_ray_twin(b)))) for b in ours]
             pairs = [(b, r) for b, r in pairs if r[0] is not None]
             if not pairs:
                 continue

@@ -19,20 +19,10 @@ import statistics
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from report import InputError, geometric_mean, ordered, read_meta, read_table  # noqa: E402
+from report import InputError, geometric_mean, ordered, rate_samples, read_meta, read_table  # noqa: E402
 
 REQUIRED = ["scene", "rayset", "backend", "threads", "mrays_s", "mrays_s_samples"]
 NUMERIC = ["threads", "mrays_s"]
-
-
-def samples_of(path, row):
-    try:
-        values = [float(s) for s in row["mrays_s_samples"].split(";")]
-    except ValueError:
-        raise InputError(path, f"{row['scene']}/{row['rayset']}/{row['backend']}: unreadable mrays_s_samples")
-    if not values or any(not v > 0 for v in values):
-        raise InputError(path, f"{row['scene']}/{row['rayset']}/{row['backend']}: samples must be > 0")
-    return values
 
 
 def paired_rows(path, rows, plugin, builtin):
@@ -45,7 +35,7 @@ def paired_rows(path, rows, plugin, builtin):
             b = by_key.get((scene, rayset, builtin, 1))
             if not p or not b:
                 continue
-            ps, bs = samples_of(path, p), samples_of(path, b)
+            ps, bs = rate_samples(path, p), rate_samples(path, b)
             if len(ps) != len(bs):
                 raise InputError(path, f"{scene}/{rayset}: {len(ps)} plugin samples against {len(bs)} built-in ones;"
                                  " a paired comparison needs one of each per round")

@@ -145,6 +145,20 @@ def read_table(path, required, numeric, check=None):
     return rows
 
 
+def rate_samples(path, row):
+    """A results row's rate samples in round order (mrays_s_samples, `;`-separated Mrays/s);
+    InputError unless every one is a positive number."""
+    text = row["mrays_s_samples"]
+    try:
+        samples = [float(s) for s in text.split(";")]
+    except ValueError:
+        samples = []
+    if not samples or not all(s > 0 for s in samples):
+        raise InputError(path, f"{row['scene']}/{row['rayset']}/{row['backend']}/threads {row['threads']}: "
+                               f"mrays_s_samples must be positive numbers separated by ';', not {text!r}")
+    return samples
+
+
 def parse_row(path, line, row, numeric):
     """One CSV row with its numeric fields converted; threads become int."""
     parsed = {key: value.strip() for key, value in row.items()}
