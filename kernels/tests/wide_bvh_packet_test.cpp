@@ -177,14 +177,15 @@ TEST(WideBvhPacket, AnswersEveryRayAsTheSingleRayTraversalWithWatertightLeaves) 
   expect_same_answers<Bvh8Watertight>("watertight");
 }
 
-// Every batch length and offset (the tails of every length 1-15 and packets
-// that start anywhere), on the coherent camera rays.
+// Every batch length and offset (the tails of every length 1 to
+// kPacketRays - 1, 31 with AVX-512, and packets that start anywhere), on the
+// coherent camera rays.
 TEST(WideBvhPacket, TailsOfEveryLengthAnswerAsSingleRays) {
   const std::vector<Triangle> tris = scene_with_ties();
   const Bvh8 bvh = build<WideMollerTrumbore>(tris);
   const std::vector<Ray> rays = camera_rays({0.5f, 0.3f, 9.0f}, 16, 8);
   for (std::size_t first = 0; first < 8; ++first)
-    for (std::size_t n = 1; n <= 17 && first + n <= rays.size(); ++n) {
+    for (std::size_t n = 1; n <= kPacketRays + 1 && first + n <= rays.size(); ++n) {
       const std::span<const Ray> part(rays.data() + first, n);
       std::vector<Hit> single(n), packet(n);
       intersect_wide_batch<WideMollerTrumbore, SlabFma>(bvh, part, single);
@@ -234,9 +235,11 @@ TEST(WideBvhPacket, CoherentBlocksFormPacketsAndScatteredRaysDoNot) {
   // a packet on each side.
   EXPECT_GT(packet_rays(camera), 0.95);
   EXPECT_LT(packet_rays(camera), 1.0);
-  // Scattered rays: a rare lead finds two companions among 15 rays.
-  EXPECT_LT(packet_rays(testing::rays_at(tris, "inside", 4096, 3)), 0.01);
-  EXPECT_LT(packet_rays(testing::rays_at(tris, "random", 4096, 3)), 0.01);
+  // Scattered rays: a rare lead finds two companions among the group's
+  // other rays (15 or 7; among 31, about four times as often: 2 % here).
+  const double rare = kPacketRays <= 16 ? 0.01 : 0.03;
+  EXPECT_LT(packet_rays(testing::rays_at(tris, "inside", 4096, 3)), rare);
+  EXPECT_LT(packet_rays(testing::rays_at(tris, "random", 4096, 3)), rare);
 }
 
 }  // namespace

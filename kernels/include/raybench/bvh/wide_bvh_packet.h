@@ -1,4 +1,4 @@
-// Packets of coherent rays (16 with AVX-512, 8 with AVX2) traced together
+// Packets of coherent rays (32 with AVX-512, 8 with AVX2) traced together
 // through a Bvh8, closest hit and any hit, with exactly the answers of the
 // single-ray traversal (wide_bvh_traverse.h): the `bvh8:packet` backends.
 // Algorithm: a packet visits a node once for all its rays (Wald, Slusallek,
@@ -21,7 +21,7 @@
 // rays, ray by ray with the single-ray pack test. With 8-ray packets, a
 // subtree left with kAloneAtMost active rays is traced by each alone
 // (traverse_wide_from), as Embree's hybrid traversal turns to single rays
-// (bvh_intersector_hybrid.cpp); 16-ray packets stay whole (measured faster).
+// (bvh_intersector_hybrid.cpp); AVX-512's packets stay whole (measured faster).
 // Grouping: a group of kPacketRays consecutive rays forms a packet of those
 // that share the first usable ray's octant (finite, no zero direction
 // component: SlabFma's rays), point within kMinPacketCosine of its
@@ -50,27 +50,31 @@
 
 namespace raybench {
 
-// Rays per packet, one per float lane: AVX-512's 16 (FloatLanes<16>) or AVX2's 8.
+// Rays per packet, one per float lane: AVX-512's 32 (FloatLanes<32>, two
+// registers; on Zen 5 tiled rays 18-26 % faster than with 16 in one:
+// docs/notes/kernels-packets.md) or AVX2's 8.
 #if defined(RAYBENCH_AVX512)
-inline constexpr int kPacketRays = 16;
+inline constexpr int kPacketRays = 32;
 #else
 inline constexpr int kPacketRays = 8;
 #endif
 inline constexpr int kMinPacketRays = 3;
-// Active rays in a subtree that go on alone: none of 16 (measured on Zen 4
-// once thin leaves were tested ray by ray: handing off 1, 2 or 3 of 16 was
-// 2-9 % slower on tiled rays, most on the terrain), 2 of 8 (measured with
-// AVX-512 disabled, before: 1 of 8 was 2 % slower on tiled shadow rays, 3 of
-// 8 1.5 % on tiled primary rays).
-inline constexpr int kAloneAtMost = kPacketRays == 16 ? 0 : 2;
+// Active rays in a subtree that go on alone: none with AVX-512 (measured on
+// Zen 4 with 16-ray packets, once thin leaves were tested ray by ray: handing
+// off 1, 2 or 3 of 16 was 2-9 % slower on tiled rays, most on the terrain),
+// 2 of 8 (measured with AVX-512 disabled, before: 1 of 8 was 2 % slower on
+// tiled shadow rays, 3 of 8 1.5 % on tiled primary rays).
+inline constexpr int kAloneAtMost = kPacketRays >= 16 ? 0 : 2;
 // Active rays at a Möller-Trumbore leaf that test its packs each alone (the
 // single-ray pack test, 8 triangles at once) rather than all at once
-// (intersect_pack_rays, 16 rays at once): 12 of 16. Measured on Zen 4, tiled
-// primary and shadow rays 5-8 % faster than with every leaf tested for all
-// rays at once, 8 or 16 of 16 less so (docs/notes/kernels-packets.md).
+// (intersect_pack_rays, every ray at once): three quarters of the packet.
+// Measured on Zen 4 with 16-ray packets, 12 of 16: tiled primary and shadow
+// rays 5-8 % faster than with every leaf tested for all rays at once, 8 or
+// 16 of 16 less so; with 32 on Zen 5, 16, 20, 24 and 28 of 32 within noise
+// of each other (docs/notes/kernels-packets.md).
 inline constexpr int kLeafAloneAtMost = kPacketRays * 3 / 4;
 // Active rays at a node, for any hit, that test its 8 children each alone
-// (children_ray_by_ray) instead of the frustum test and a 16-ray test per
+// (children_ray_by_ray) instead of the frustum test and a packet-wide test per
 // child it picks: 2. Measured on Zen 4: the terrain's tiled shadow rays
 // 3-12 % faster, ten other scenes within noise; for closest hit, tiled
 // primary rays were 2 % slower (docs/notes/kernels-packets.md).
@@ -83,6 +87,9 @@ inline constexpr float kMinPacketCosine = 0.97f;        // directions within abo
 inline constexpr float kMaxPacketOriginSpread = 0.05f;  // of the tree's bounds diagonal
 // kMaxPacketOriginSpread of the diagonal of `extent`, a tree's bounds.
 inline float max_packet_origin_distance(const BBox& extent) { return kMaxPacketOriginSpread * length(extent.extent()); }
+
+// Bits 0 to n - 1 (n <= 32): a group of n rays, one bit each.
+inline unsigned lanes_below(int n) { return n >= 32 ? ~0u : (1u << n) - 1u; }
 
 // The rays of a group traced as one packet (bit i: ray i of the group), and
 // their shared octant; lanes == 0: every ray alone.
@@ -97,7 +104,7 @@ namespace wide_packet_detail {
 using F = simd::FloatLanes<kPacketRays>;  // one ray per lane
 using F8 = simd::FloatLanes<8>;           // a node's 8 children
 
-using M = decltype(F::set1(0.0f) <= F::set1(0.0f));  // a lane mask: FloatLanes<8> (AVX2) or LaneMask16
+using M = decltype(F::set1(0.0f) <= F::set1(0.0f));  // a lane mask: FloatLanes<8> (AVX2) or LaneMask32
 
 inline F nan_lanes() { return F::set1(std::numeric_limits<float>::quiet_NaN()); }
 
@@ -176,15 +183,18 @@ inline unsigned load_group(const Ray* rays, int n, Packet& p) {
   return usable.mask();
 }
 
-// A packet's 8 or 16 lanes folded to 8 by min or max (for the frustum).
+// A packet's 8, 16 or 32 lanes folded to 8 by min or max (for the frustum).
 inline F8 fold_min(F8 x) { return x; }
 inline F8 fold_max(F8 x) { return x; }
-// Lane `i` of a packet's 8 or 16 in each of 8 lanes.
+// Lane `i` of a packet's 8, 16 or 32 in each of 8 lanes.
 inline F8 lane_of(F8 x, int i) { return simd::broadcast_lane(x, i); }
 #if defined(RAYBENCH_AVX512)
 inline F8 fold_min(simd::FloatLanes<16> x) { return min(simd::half_of<0>(x), simd::half_of<1>(x)); }
 inline F8 fold_max(simd::FloatLanes<16> x) { return max(simd::half_of<0>(x), simd::half_of<1>(x)); }
-inline F8 lane_of(simd::FloatLanes<16> x, int i) { return simd::broadcast_lane8(x, i); }
+inline F8 fold_min(simd::FloatLanes<32> x) { return fold_min(min(x.lo, x.hi)); }
+inline F8 fold_max(simd::FloatLanes<32> x) { return fold_max(max(x.lo, x.hi)); }
+template <int W>
+inline F8 lane_of(simd::FloatLanes<W> x, int i) { return simd::broadcast_lane8(x, i); }
 #endif
 
 // Asks for every 64-byte cache line of `x` ahead of its use: a hint, it
@@ -641,7 +651,7 @@ inline constexpr int kMaxPacketsPerGroup = 4;
 template <typename InPacket>
 unsigned plan_group(const Ray* rays, int n, float max_origin_distance, const BBox& extent, Packet& p,
                     InPacket&& in_packet) {
-  unsigned left = (1u << n) - 1u;
+  unsigned left = lanes_below(n);
   unsigned candidates = load_group(rays, n, p);
   for (int k = 0; k < kMaxPacketsPerGroup && std::popcount(candidates) >= kMinPacketRays; ++k) {
     const PacketPlan plan = plan_packet(rays, candidates, max_origin_distance, extent, p);
@@ -667,7 +677,7 @@ inline unsigned packet_lanes(const Ray* rays, int n, const BBox& extent) {
   wide_packet_detail::Packet p;
   const unsigned left = wide_packet_detail::plan_group(rays, n, max_packet_origin_distance(extent), extent, p,
                                                        [](const wide_packet_detail::Packet&, PacketPlan) {});
-  return ((1u << n) - 1u) & ~left;
+  return lanes_below(n) & ~left;
 #else
   (void)rays, (void)n, (void)extent;
   return 0;

@@ -13,7 +13,8 @@
 // -march=native on such a host) the same widths gain comparisons into a lane
 // mask (vcmpps k, chained under a mask for an and), for the leaf tests; they
 // answer bit for bit as compare-and-movemask; FloatLanes<16> is AVX-512's
-// __m512, for the packet traversal. What AVX-512 paid and did not:
+// __m512 and FloatLanes<32> two of them, for the packet traversal. What
+// AVX-512 paid and did not:
 // docs/notes/kernels-wide-traversal.md
 #pragma once
 
@@ -323,6 +324,67 @@ inline void FloatLanes<16>::load_transposed8(const float* rows, FloatLanes (&out
     out[k] = {_mm512_permutex2var_ps(tlo[k], even, thi[k])};
     out[k + 4] = {_mm512_permutex2var_ps(tlo[k], odd, thi[k])};
   }
+}
+
+// 32 float lanes in two AVX-512 registers, for the packet traversal's 32
+// rays: each operation is the 16-lane one on either half (lanes 0-15 in lo,
+// 16-31 in hi), so every lane computes exactly what FloatLanes<16> computes.
+// A packet of 32 shares each node's fetch, frustum test and branches among
+// twice the rays (docs/notes/kernels-packets.md, "32-ray packets").
+struct LaneMask32 {
+  __mmask16 lo, hi;
+  static LaneMask32 from_bits(unsigned bits) { return {static_cast<__mmask16>(bits), static_cast<__mmask16>(bits >> 16)}; }
+  unsigned mask() const { return static_cast<unsigned>(lo) | static_cast<unsigned>(hi) << 16; }
+  LaneMask32 operator&(LaneMask32 o) const { return {static_cast<__mmask16>(lo & o.lo), static_cast<__mmask16>(hi & o.hi)}; }
+};
+
+template <>
+struct FloatLanes<32> {
+  using Half = FloatLanes<16>;
+  Half lo, hi;
+  static FloatLanes set1(float x) {
+    const Half h = Half::set1(x);
+    return {h, h};
+  }
+  static FloatLanes load(const float* p) { return {Half::load(p), Half::load(p + 16)}; }
+  // The 32 rows of 8 floats at `rows` transposed: lane i of out[k] is rows[i * 8 + k].
+  static void load_transposed8(const float* rows, FloatLanes (&out)[8]) {
+    Half lo[8], hi[8];
+    Half::load_transposed8(rows, lo);
+    Half::load_transposed8(rows + 16 * 8, hi);
+    for (int k = 0; k < 8; ++k) out[k] = {lo[k], hi[k]};
+  }
+  void storeu(float* p) const {
+    lo.storeu(p);
+    hi.storeu(p + 16);
+  }
+  FloatLanes operator+(FloatLanes o) const { return {lo + o.lo, hi + o.hi}; }
+  FloatLanes operator-(FloatLanes o) const { return {lo - o.lo, hi - o.hi}; }
+  FloatLanes operator*(FloatLanes o) const { return {lo * o.lo, hi * o.hi}; }
+  FloatLanes operator/(FloatLanes o) const { return {lo / o.lo, hi / o.hi}; }
+  FloatLanes operator^(FloatLanes o) const { return {lo ^ o.lo, hi ^ o.hi}; }
+  LaneMask32 operator<=(FloatLanes o) const { return {(lo <= o.lo).k, (hi <= o.hi).k}; }
+  LaneMask32 operator<(FloatLanes o) const { return {(lo < o.lo).k, (hi < o.hi).k}; }
+  LaneMask32 operator>=(FloatLanes o) const { return {(lo >= o.lo).k, (hi >= o.hi).k}; }
+  LaneMask32 operator>(FloatLanes o) const { return {(lo > o.lo).k, (hi > o.hi).k}; }
+  LaneMask32 operator!=(FloatLanes o) const { return {(lo != o.lo).k, (hi != o.hi).k}; }
+  FloatLanes abs() const { return {lo.abs(), hi.abs()}; }
+  FloatLanes sign() const { return {lo.sign(), hi.sign()}; }
+};
+inline FloatLanes<32> max(FloatLanes<32> a, FloatLanes<32> b) { return {max(a.lo, b.lo), max(a.hi, b.hi)}; }
+inline FloatLanes<32> min(FloatLanes<32> a, FloatLanes<32> b) { return {min(a.lo, b.lo), min(a.hi, b.hi)}; }
+inline FloatLanes<32> fmadd(FloatLanes<32> a, FloatLanes<32> b, FloatLanes<32> c) {
+  return {fmadd(a.lo, b.lo, c.lo), fmadd(a.hi, b.hi, c.hi)};
+}
+inline FloatLanes<32> fmsub(FloatLanes<32> a, FloatLanes<32> b, FloatLanes<32> c) {
+  return {fmsub(a.lo, b.lo, c.lo), fmsub(a.hi, b.hi, c.hi)};
+}
+inline FloatLanes<32> select(LaneMask32 m, FloatLanes<32> a, FloatLanes<32> b) {
+  return {select(LaneMask16{m.lo}, a.lo, b.lo), select(LaneMask16{m.hi}, a.hi, b.hi)};
+}
+// Lane `k` of x (0-31) in each of 8 lanes.
+inline FloatLanes<8> broadcast_lane8(FloatLanes<32> x, int k) {
+  return k < 16 ? broadcast_lane8(x.lo, k) : broadcast_lane8(x.hi, k - 16);
 }
 #endif
 
