@@ -294,21 +294,30 @@ TEST(FloatLanes, AnyOfSixteenLanesBroadcastsIntoEight) {
     for (float v : lanes) EXPECT_EQ(std::bit_cast<std::uint32_t>(v), std::bit_cast<std::uint32_t>(values[k])) << "lane " << k;
   }
 }
+#endif
 
-// 32 lanes in two registers: each lane as the 16-lane operations compute
-// it, the comparisons' masks bit i for lane i (lanes 16-31 in the high
-// half), and the transpose's lane i row i.
-TEST(FloatLanes, ThirtyTwoLanesComputeAsTwoSixteens) {
-  using F32 = simd::FloatLanes<32>;
-  alignas(64) float a[32], b[32], rows[32 * 8];
-  for (int i = 0; i < 32; ++i) {
+// Two registers of lanes (LanePair: the packets' 32 lanes with AVX-512, 16
+// with AVX2): each lane as one register computes it, the comparisons' masks
+// bit i for lane i (the high register's lanes in the high bits), and the
+// transpose's lane i row i.
+#if defined(RAYBENCH_AVX512)
+using LanePairUnderTest = simd::LanePair<simd::FloatLanes<16>, 16>;
+constexpr int kPairLanes = 32;
+#else
+using LanePairUnderTest = simd::LanePair<simd::FloatLanes<8>, 8>;
+constexpr int kPairLanes = 16;
+#endif
+TEST(FloatLanes, TwoRegistersComputeLaneByLaneAsOne) {
+  using P = LanePairUnderTest;
+  alignas(64) float a[kPairLanes], b[kPairLanes], rows[kPairLanes * 8];
+  for (int i = 0; i < kPairLanes; ++i) {
     a[i] = static_cast<float>(i) * 0.75f - 11.0f;
-    b[i] = static_cast<float>(31 - i) * 0.5f - 3.0f;
+    b[i] = static_cast<float>(kPairLanes - 1 - i) * 0.5f - 3.0f;
     for (int k = 0; k < 8; ++k) rows[i * 8 + k] = static_cast<float>(i * 8 + k);
   }
-  a[20] = std::numeric_limits<float>::quiet_NaN();
-  const F32 x = F32::load(a), y = F32::load(b);
-  alignas(64) float sum[32], product[32], fused[32], low[32], picked[32];
+  a[kPairLanes / 2 + 3] = std::numeric_limits<float>::quiet_NaN();  // in the high register
+  const P x = P::load(a), y = P::load(b);
+  alignas(64) float sum[kPairLanes], product[kPairLanes], fused[kPairLanes], low[kPairLanes], picked[kPairLanes];
   (x + y).storeu(sum);
   (x * y).storeu(product);
   fmsub(x, y, x).storeu(fused);
@@ -316,7 +325,7 @@ TEST(FloatLanes, ThirtyTwoLanesComputeAsTwoSixteens) {
   const unsigned le = (x <= y).mask();
   select(x <= y, x, y).storeu(picked);
   unsigned want_le = 0;
-  for (int i = 0; i < 32; ++i) {
+  for (int i = 0; i < kPairLanes; ++i) {
     EXPECT_EQ(std::bit_cast<std::uint32_t>(sum[i]), std::bit_cast<std::uint32_t>(a[i] + b[i])) << i;
     EXPECT_EQ(std::bit_cast<std::uint32_t>(product[i]), std::bit_cast<std::uint32_t>(a[i] * b[i])) << i;
     EXPECT_EQ(std::bit_cast<std::uint32_t>(fused[i]), std::bit_cast<std::uint32_t>(std::fma(a[i], b[i], -a[i]))) << i;
@@ -326,21 +335,20 @@ TEST(FloatLanes, ThirtyTwoLanesComputeAsTwoSixteens) {
     EXPECT_EQ(std::bit_cast<std::uint32_t>(picked[i]), std::bit_cast<std::uint32_t>(a[i] <= b[i] ? a[i] : b[i])) << i;
   }
   EXPECT_EQ(le, want_le);
-  EXPECT_EQ(simd::LaneMask32::from_bits(want_le).mask(), want_le);
-  F32 fields[8];
-  F32::load_transposed8(rows, fields);
+  EXPECT_EQ(P::Mask::from_bits(want_le).mask(), want_le);
+  P fields[8];
+  P::load_transposed8(rows, fields);
   for (int k = 0; k < 8; ++k) {
-    alignas(64) float lanes[32];
+    alignas(64) float lanes[kPairLanes];
     fields[k].storeu(lanes);
-    for (int i = 0; i < 32; ++i) EXPECT_EQ(lanes[i], rows[i * 8 + k]) << "field " << k << " lane " << i;
+    for (int i = 0; i < kPairLanes; ++i) EXPECT_EQ(lanes[i], rows[i * 8 + k]) << "field " << k << " lane " << i;
   }
-  for (int k = 0; k < 32; k += 7) {
+  for (int k = 0; k < kPairLanes; k += 3) {
     alignas(32) float lanes[8];
     simd::broadcast_lane8(y, k).storeu(lanes);
     for (float v : lanes) EXPECT_EQ(v, b[k]) << "broadcast of lane " << k;
   }
 }
-#endif
 #endif
 
 }  // namespace

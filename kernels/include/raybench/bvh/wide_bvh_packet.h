@@ -1,4 +1,4 @@
-// Packets of coherent rays (32 with AVX-512, 8 with AVX2) traced together
+// Packets of coherent rays (32 with AVX-512, 16 with AVX2) traced together
 // through a Bvh8, closest hit and any hit, with exactly the answers of the
 // single-ray traversal (wide_bvh_traverse.h): the `bvh8:packet` backends.
 // Algorithm: a packet visits a node once for all its rays (Wald, Slusallek,
@@ -18,10 +18,10 @@
 // Möller-Trumbore leaves reached by most of the packet's rays test each
 // triangle against every ray at once (the pack test with the lanes' roles
 // swapped, same operations); other leaves, and those reached by fewer
-// rays, ray by ray with the single-ray pack test. With 8-ray packets, a
-// subtree left with kAloneAtMost active rays is traced by each alone
-// (traverse_wide_from), as Embree's hybrid traversal turns to single rays
-// (bvh_intersector_hybrid.cpp); AVX-512's packets stay whole (measured faster).
+// rays, ray by ray with the single-ray pack test. A packet stays whole down
+// to one active ray: handing the last few to single-ray traversal, as
+// Embree's hybrid traversal does (bvh_intersector_hybrid.cpp), measured
+// slower with 16-ray packets, in AVX-512 and AVX2 builds alike.
 // Grouping: a group of kPacketRays consecutive rays forms a packet of those
 // that share the first usable ray's octant (finite, no zero direction
 // component: SlabFma's rays), point within kMinPacketCosine of its
@@ -50,21 +50,16 @@
 
 namespace raybench {
 
-// Rays per packet, one per float lane: AVX-512's 32 (FloatLanes<32>, two
-// registers; on Zen 5 tiled rays 18-26 % faster than with 16 in one:
-// docs/notes/kernels-packets.md) or AVX2's 8.
+// Rays per packet, one per float lane, in two registers: AVX-512's 32 or
+// AVX2's 16. On Zen 5, tiled rays 18-26 % faster than 16 in one AVX-512
+// register, and with AVX-512 off 9-12 % faster than 8 in one AVX2 register
+// (docs/notes/kernels-packets.md).
 #if defined(RAYBENCH_AVX512)
 inline constexpr int kPacketRays = 32;
 #else
-inline constexpr int kPacketRays = 8;
+inline constexpr int kPacketRays = 16;
 #endif
 inline constexpr int kMinPacketRays = 3;
-// Active rays in a subtree that go on alone: none with AVX-512 (measured on
-// Zen 4 with 16-ray packets, once thin leaves were tested ray by ray: handing
-// off 1, 2 or 3 of 16 was 2-9 % slower on tiled rays, most on the terrain),
-// 2 of 8 (measured with AVX-512 disabled, before: 1 of 8 was 2 % slower on
-// tiled shadow rays, 3 of 8 1.5 % on tiled primary rays).
-inline constexpr int kAloneAtMost = kPacketRays >= 16 ? 0 : 2;
 // Active rays at a Möller-Trumbore leaf that test its packs each alone (the
 // single-ray pack test, 8 triangles at once) rather than all at once
 // (intersect_pack_rays, every ray at once): three quarters of the packet.
@@ -101,10 +96,15 @@ struct PacketPlan {
 #if defined(__AVX2__)
 namespace wide_packet_detail {
 
-using F = simd::FloatLanes<kPacketRays>;  // one ray per lane
-using F8 = simd::FloatLanes<8>;           // a node's 8 children
+// One ray per lane: two registers of 16 (AVX-512) or of 8 (AVX2).
+#if defined(RAYBENCH_AVX512)
+using F = simd::LanePair<simd::FloatLanes<16>, 16>;
+#else
+using F = simd::LanePair<simd::FloatLanes<8>, 8>;
+#endif
+using F8 = simd::FloatLanes<8>;  // a node's 8 children
 
-using M = decltype(F::set1(0.0f) <= F::set1(0.0f));  // a lane mask: FloatLanes<8> (AVX2) or LaneMask32
+using M = decltype(F::set1(0.0f) <= F::set1(0.0f));  // a lane mask: LanePair's Mask
 
 inline F nan_lanes() { return F::set1(std::numeric_limits<float>::quiet_NaN()); }
 
@@ -183,19 +183,19 @@ inline unsigned load_group(const Ray* rays, int n, Packet& p) {
   return usable.mask();
 }
 
-// A packet's 8, 16 or 32 lanes folded to 8 by min or max (for the frustum).
+// A packet's lanes folded to 8 by min or max (for the frustum).
 inline F8 fold_min(F8 x) { return x; }
 inline F8 fold_max(F8 x) { return x; }
-// Lane `i` of a packet's 8, 16 or 32 in each of 8 lanes.
-inline F8 lane_of(F8 x, int i) { return simd::broadcast_lane(x, i); }
 #if defined(RAYBENCH_AVX512)
 inline F8 fold_min(simd::FloatLanes<16> x) { return min(simd::half_of<0>(x), simd::half_of<1>(x)); }
 inline F8 fold_max(simd::FloatLanes<16> x) { return max(simd::half_of<0>(x), simd::half_of<1>(x)); }
-inline F8 fold_min(simd::FloatLanes<32> x) { return fold_min(min(x.lo, x.hi)); }
-inline F8 fold_max(simd::FloatLanes<32> x) { return fold_max(max(x.lo, x.hi)); }
-template <int W>
-inline F8 lane_of(simd::FloatLanes<W> x, int i) { return simd::broadcast_lane8(x, i); }
 #endif
+template <typename Half, int H>
+inline F8 fold_min(simd::LanePair<Half, H> x) { return fold_min(min(x.lo, x.hi)); }
+template <typename Half, int H>
+inline F8 fold_max(simd::LanePair<Half, H> x) { return fold_max(max(x.lo, x.hi)); }
+// Lane `i` of a packet's lanes in each of 8 lanes.
+inline F8 lane_of(F x, int i) { return simd::broadcast_lane8(x, i); }
 
 // Asks for every 64-byte cache line of `x` ahead of its use: a hint, it
 // changes no result.
@@ -480,27 +480,7 @@ void trace_packet(const Bvh8& bvh, const Ray* rays, const wide_packet_detail::Pa
   unsigned active = plan.lanes;
   F node_tnear = select(planned, p.tnear, nan_lanes());  // tnear in the lanes active at the node, NaN in the others
   for (;;) {
-    if (kAloneAtMost > 0 && std::popcount(active) <= kAloneAtMost) {
-      // Few rays left in this subtree: each goes on alone from here.
-      unsigned occluded_rays = 0;
-      for (unsigned lanes = active; lanes; lanes &= lanes - 1) {
-        const int i = std::countr_zero(lanes);
-        if constexpr (AnyHit) {
-          if (traverse_wide_from<true, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, Hit{})) occluded_rays |= 1u << i;
-        } else {
-          const Hit h = traverse_wide_from<false, Leaf, SlabFma, PackSlots>(bvh, rays[i], ref, hit_of(i));
-          if (h.hit()) {
-            set_hit(i, h);
-            reach = select(M::from_bits(1u << i), F::set1(h.t), reach);  // not reloaded from tmax (see the leaves)
-          }
-        }
-      }
-      if constexpr (AnyHit) {
-        if (occluded_rays) mark_occluded(occluded_rays);
-      } else {
-        set_exit();
-      }
-    } else if (ref & Bvh8::kLeafBit) {
+    if (ref & Bvh8::kLeafBit) {
       // The leaf's packs in order, as the single-ray traversal tests them.
       const std::uint32_t first = Bvh8::first_pack(ref), end = first + Bvh8::pack_count(ref);
       const bool ray_lanes = kRayLanesLeaf<Leaf> && std::popcount(active & ~done) > kLeafAloneAtMost;

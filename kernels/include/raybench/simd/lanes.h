@@ -13,7 +13,7 @@
 // -march=native on such a host) the same widths gain comparisons into a lane
 // mask (vcmpps k, chained under a mask for an and), for the leaf tests; they
 // answer bit for bit as compare-and-movemask; FloatLanes<16> is AVX-512's
-// __m512 and FloatLanes<32> two of them, for the packet traversal. What
+// __m512, for the packet traversal (two of them: LanePair below). What
 // AVX-512 paid and did not:
 // docs/notes/kernels-wide-traversal.md
 #pragma once
@@ -326,67 +326,78 @@ inline void FloatLanes<16>::load_transposed8(const float* rows, FloatLanes (&out
   }
 }
 
-// 32 float lanes in two AVX-512 registers, for the packet traversal's 32
-// rays: each operation is the 16-lane one on either half (lanes 0-15 in lo,
-// 16-31 in hi), so every lane computes exactly what FloatLanes<16> computes.
-// A packet of 32 shares each node's fetch, frustum test and branches among
-// twice the rays (docs/notes/kernels-packets.md, "32-ray packets").
-struct LaneMask32 {
-  __mmask16 lo, hi;
-  static LaneMask32 from_bits(unsigned bits) { return {static_cast<__mmask16>(bits), static_cast<__mmask16>(bits >> 16)}; }
-  unsigned mask() const { return static_cast<unsigned>(lo) | static_cast<unsigned>(hi) << 16; }
-  LaneMask32 operator&(LaneMask32 o) const { return {static_cast<__mmask16>(lo & o.lo), static_cast<__mmask16>(hi & o.hi)}; }
-};
+#endif
 
-template <>
-struct FloatLanes<32> {
-  using Half = FloatLanes<16>;
+// Lane `k` of x in each of 8 lanes (AVX2's form of broadcast_lane8).
+inline FloatLanes<8> broadcast_lane8(FloatLanes<8> x, int k) { return broadcast_lane(x, k); }
+
+// Twice a register's lanes in two registers (lanes 0 to H - 1 in lo, H to
+// 2H - 1 in hi), every operation the register's own on either half, so each
+// lane computes exactly what it computes in one: the packet traversal's 32
+// rays with AVX-512 (two FloatLanes<16>), 16 with AVX2 (two FloatLanes<8>).
+// A packet of twice the rays shares each node's fetch, frustum test and
+// branches among them (docs/notes/kernels-packets.md, "32-ray packets").
+template <typename Half, int H>
+struct LanePair {
+  using HalfMask = decltype(Half::set1(0.0f) <= Half::set1(0.0f));
+  // The comparisons' answer: bit i of mask() for lane i.
+  struct Mask {
+    HalfMask lo, hi;
+    static Mask from_bits(unsigned bits) { return {HalfMask::from_bits(bits & ((1u << H) - 1u)), HalfMask::from_bits(bits >> H)}; }
+    unsigned mask() const { return lo.mask() | hi.mask() << H; }
+    Mask operator&(Mask o) const { return {lo & o.lo, hi & o.hi}; }
+  };
   Half lo, hi;
-  static FloatLanes set1(float x) {
+  static LanePair set1(float x) {
     const Half h = Half::set1(x);
     return {h, h};
   }
-  static FloatLanes load(const float* p) { return {Half::load(p), Half::load(p + 16)}; }
-  // The 32 rows of 8 floats at `rows` transposed: lane i of out[k] is rows[i * 8 + k].
-  static void load_transposed8(const float* rows, FloatLanes (&out)[8]) {
+  static LanePair load(const float* p) { return {Half::load(p), Half::load(p + H)}; }
+  // The 2H rows of 8 floats at `rows` transposed: lane i of out[k] is rows[i * 8 + k].
+  static void load_transposed8(const float* rows, LanePair (&out)[8]) {
     Half lo[8], hi[8];
     Half::load_transposed8(rows, lo);
-    Half::load_transposed8(rows + 16 * 8, hi);
+    Half::load_transposed8(rows + H * 8, hi);
     for (int k = 0; k < 8; ++k) out[k] = {lo[k], hi[k]};
   }
   void storeu(float* p) const {
     lo.storeu(p);
-    hi.storeu(p + 16);
+    hi.storeu(p + H);
   }
-  FloatLanes operator+(FloatLanes o) const { return {lo + o.lo, hi + o.hi}; }
-  FloatLanes operator-(FloatLanes o) const { return {lo - o.lo, hi - o.hi}; }
-  FloatLanes operator*(FloatLanes o) const { return {lo * o.lo, hi * o.hi}; }
-  FloatLanes operator/(FloatLanes o) const { return {lo / o.lo, hi / o.hi}; }
-  FloatLanes operator^(FloatLanes o) const { return {lo ^ o.lo, hi ^ o.hi}; }
-  LaneMask32 operator<=(FloatLanes o) const { return {(lo <= o.lo).k, (hi <= o.hi).k}; }
-  LaneMask32 operator<(FloatLanes o) const { return {(lo < o.lo).k, (hi < o.hi).k}; }
-  LaneMask32 operator>=(FloatLanes o) const { return {(lo >= o.lo).k, (hi >= o.hi).k}; }
-  LaneMask32 operator>(FloatLanes o) const { return {(lo > o.lo).k, (hi > o.hi).k}; }
-  LaneMask32 operator!=(FloatLanes o) const { return {(lo != o.lo).k, (hi != o.hi).k}; }
-  FloatLanes abs() const { return {lo.abs(), hi.abs()}; }
-  FloatLanes sign() const { return {lo.sign(), hi.sign()}; }
+  LanePair operator+(LanePair o) const { return {lo + o.lo, hi + o.hi}; }
+  LanePair operator-(LanePair o) const { return {lo - o.lo, hi - o.hi}; }
+  LanePair operator*(LanePair o) const { return {lo * o.lo, hi * o.hi}; }
+  LanePair operator/(LanePair o) const { return {lo / o.lo, hi / o.hi}; }
+  LanePair operator^(LanePair o) const { return {lo ^ o.lo, hi ^ o.hi}; }
+  Mask operator<=(LanePair o) const { return {lo <= o.lo, hi <= o.hi}; }
+  Mask operator<(LanePair o) const { return {lo < o.lo, hi < o.hi}; }
+  Mask operator>=(LanePair o) const { return {lo >= o.lo, hi >= o.hi}; }
+  Mask operator>(LanePair o) const { return {lo > o.lo, hi > o.hi}; }
+  Mask operator!=(LanePair o) const { return {lo != o.lo, hi != o.hi}; }
+  LanePair abs() const { return {lo.abs(), hi.abs()}; }
+  LanePair sign() const { return {lo.sign(), hi.sign()}; }
 };
-inline FloatLanes<32> max(FloatLanes<32> a, FloatLanes<32> b) { return {max(a.lo, b.lo), max(a.hi, b.hi)}; }
-inline FloatLanes<32> min(FloatLanes<32> a, FloatLanes<32> b) { return {min(a.lo, b.lo), min(a.hi, b.hi)}; }
-inline FloatLanes<32> fmadd(FloatLanes<32> a, FloatLanes<32> b, FloatLanes<32> c) {
+template <typename Half, int H>
+inline LanePair<Half, H> max(LanePair<Half, H> a, LanePair<Half, H> b) { return {max(a.lo, b.lo), max(a.hi, b.hi)}; }
+template <typename Half, int H>
+inline LanePair<Half, H> min(LanePair<Half, H> a, LanePair<Half, H> b) { return {min(a.lo, b.lo), min(a.hi, b.hi)}; }
+template <typename Half, int H>
+inline LanePair<Half, H> fmadd(LanePair<Half, H> a, LanePair<Half, H> b, LanePair<Half, H> c) {
   return {fmadd(a.lo, b.lo, c.lo), fmadd(a.hi, b.hi, c.hi)};
 }
-inline FloatLanes<32> fmsub(FloatLanes<32> a, FloatLanes<32> b, FloatLanes<32> c) {
+template <typename Half, int H>
+inline LanePair<Half, H> fmsub(LanePair<Half, H> a, LanePair<Half, H> b, LanePair<Half, H> c) {
   return {fmsub(a.lo, b.lo, c.lo), fmsub(a.hi, b.hi, c.hi)};
 }
-inline FloatLanes<32> select(LaneMask32 m, FloatLanes<32> a, FloatLanes<32> b) {
-  return {select(LaneMask16{m.lo}, a.lo, b.lo), select(LaneMask16{m.hi}, a.hi, b.hi)};
+template <typename Half, int H>
+inline LanePair<Half, H> select(typename LanePair<Half, H>::Mask m, LanePair<Half, H> a, LanePair<Half, H> b) {
+  return {select(m.lo, a.lo, b.lo), select(m.hi, a.hi, b.hi)};
 }
-// Lane `k` of x (0-31) in each of 8 lanes.
-inline FloatLanes<8> broadcast_lane8(FloatLanes<32> x, int k) {
-  return k < 16 ? broadcast_lane8(x.lo, k) : broadcast_lane8(x.hi, k - 16);
+// Lane `k` of x (0 to 2H - 1) in each of 8 lanes.
+template <typename Half, int H>
+inline FloatLanes<8> broadcast_lane8(LanePair<Half, H> x, int k) {
+  return k < H ? broadcast_lane8(x.lo, k) : broadcast_lane8(x.hi, k - H);
 }
-#endif
 
 }  // namespace raybench::simd
 #endif
