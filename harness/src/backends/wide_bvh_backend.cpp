@@ -155,7 +155,7 @@ std::vector<BackendInfo> wide_backend_names() {
                    fmt::format("bvh8 tracing coherent consecutive rays in packets of {} ({}: a frustum test per node, "
                                "per-ray masks, single rays where rays diverge), the same answers as bvh8 bit for bit; "
                                "triangle scenes only; any bvh8 name with the plain box test takes :packet",
-                               kPacketRays, !kHaveAvx2 ? "without AVX2 every ray alone" : kPacketRays == 32 ? "AVX-512, two registers" : "AVX2")});
+                               kPacketRays, !kHaveAvx2 ? "without AVX2 every ray alone" : kPacketRays == 32 ? "AVX-512" : "AVX2")});
   }
   out.push_back({family + ":robust", fmt::format("{} with the conservative {}-wide box test (slab_robust_ray); any {} "
                                                  "name takes :robust or :plain_boxes (slab_fma, the default) for its box test",

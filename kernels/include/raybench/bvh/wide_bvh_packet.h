@@ -194,8 +194,6 @@ template <typename Half, int H>
 inline F8 fold_min(simd::LanePair<Half, H> x) { return fold_min(min(x.lo, x.hi)); }
 template <typename Half, int H>
 inline F8 fold_max(simd::LanePair<Half, H> x) { return fold_max(max(x.lo, x.hi)); }
-// Lane `i` of a packet's lanes in each of 8 lanes.
-inline F8 lane_of(F x, int i) { return simd::broadcast_lane8(x, i); }
 
 // Asks for every 64-byte cache line of `x` ahead of its use: a hint, it
 // changes no result.
@@ -317,8 +315,8 @@ inline unsigned children_ray_by_ray(const Packet& p, const Ray* rays, const floa
     const int i = std::countr_zero(active);
     RayLanes<8> rl;
     for (int a = 0; a < 3; ++a) {
-      rl.inv_dir[a] = lane_of(p.inv_dir[a], i);
-      rl.fused_near[a] = rl.fused_far[a] = lane_of(p.fused[a], i);
+      rl.inv_dir[a] = simd::broadcast_lane8(p.inv_dir[a], i);
+      rl.fused_near[a] = rl.fused_far[a] = simd::broadcast_lane8(p.fused[a], i);
       rl.near_offset[a] = p.near_offset[a];
     }
     rl.tnear = rays[i].tnear;

@@ -325,7 +325,6 @@ inline void FloatLanes<16>::load_transposed8(const float* rows, FloatLanes (&out
     out[k + 4] = {_mm512_permutex2var_ps(tlo[k], odd, thi[k])};
   }
 }
-
 #endif
 
 // Lane `k` of x in each of 8 lanes (AVX2's form of broadcast_lane8).
