@@ -233,7 +233,17 @@ inline void FloatLanes<8>::load_transposed8(const float* rows, FloatLanes (&out)
   const auto unpackhi = [](__m256 a, __m256 b) { return _mm256_unpackhi_ps(a, b); };
   const auto shuffle = []<int Imm>(__m256 a, __m256 b) { return _mm256_shuffle_ps(a, b, Imm); };
   __m256 lo[4], hi[4], tlo[4], thi[4];  // rows 0-3 and 4-7
-  for (int i = 0; i < 4; ++i) lo[i] = _mm256_loadu_ps(rows + 8 * i), hi[i] = _mm256_loadu_ps(rows + 8 * (i + 4));
+  // A row as two 16-byte loads into one register: what GCC makes of an
+  // unaligned 256-bit load under its AMD tunings anyway, but written so it
+  // stays a register value. From _mm256_loadu_ps, GCC copied the 16 rows of
+  // a 16-ray packet to the stack in 16-byte pieces, and each 32-byte reload
+  // for the shuffles waited for both pieces to reach the cache (a failed
+  // store-to-load forward): Wuson's tiled primary rays 6-9 % slower
+  // (docs/notes/kernels-packets.md).
+  const auto row = [](const float* p) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p)), _mm_loadu_ps(p + 4), 1);
+  };
+  for (int i = 0; i < 4; ++i) lo[i] = row(rows + 8 * i), hi[i] = row(rows + 8 * (i + 4));
   transpose4_in_lanes(lo, tlo, unpacklo, unpackhi, shuffle);
   transpose4_in_lanes(hi, thi, unpacklo, unpackhi, shuffle);
   for (int k = 0; k < 4; ++k) {
@@ -342,11 +352,33 @@ struct LanePair {
   // The comparisons' answer: bit i of mask() for lane i.
   struct Mask {
     HalfMask lo, hi;
+    Mask() = default;
+    Mask(HalfMask l, HalfMask h) : lo(l), hi(h) {}
+    Mask(const Mask& o) : lo(o.lo), hi(o.hi) {}  // half by half, as LanePair below
+    Mask& operator=(const Mask& o) {
+      lo = o.lo;
+      hi = o.hi;
+      return *this;
+    }
     static Mask from_bits(unsigned bits) { return {HalfMask::from_bits(bits & ((1u << H) - 1u)), HalfMask::from_bits(bits >> H)}; }
     unsigned mask() const { return lo.mask() | hi.mask() << H; }
     Mask operator&(Mask o) const { return {lo & o.lo, hi & o.hi}; }
   };
   Half lo, hi;
+  LanePair() = default;
+  LanePair(Half l, Half h) : lo(l), hi(h) {}
+  // Copied half by half, each half one register's move. The implicit copy
+  // moves the pair as 2H floats of memory, which GCC does in 16-byte pieces
+  // where its tuning has no wider moves by pieces (generic, AMD Zen): a
+  // register-wide load of such a copy then waits for the pieces to reach
+  // the cache (a failed store-to-load forward), 39 % of the AVX2 packets'
+  // time on Wuson's tiled primary rays (docs/notes/kernels-packets.md).
+  LanePair(const LanePair& o) : lo(o.lo), hi(o.hi) {}
+  LanePair& operator=(const LanePair& o) {
+    lo = o.lo;
+    hi = o.hi;
+    return *this;
+  }
   static LanePair set1(float x) {
     const Half h = Half::set1(x);
     return {h, h};
