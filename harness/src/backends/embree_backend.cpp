@@ -59,6 +59,7 @@
 #include "raybench/prim/analytic_hit.h"
 #include "raybench/prim/obb_eigen.h"
 #include "raybench/prim/primitives.h"
+#include "raybench/simd/lanes.h"
 #include "rays/screening.h"
 
 namespace raybench {
@@ -374,8 +375,32 @@ void init_packet(RayK& packet) {
 // `rays` (at most K, screened) into the packet's lanes and the valid mask:
 // -1 where the interval is not empty (tnear <= tfar, what rtcIntersect1M
 // traces too), else 0; lanes past the rays get kEmptyRay and 0.
+// A full packet of 8 or 16 rays goes in 8 at a time, transposed in
+// registers and stored a field at a time (as our packets load theirs,
+// wide_bvh_packet.h): written lane by lane, each field was read by Embree's
+// first 32- or 64-byte load of it while its 8 or 16 stores were still on
+// their way to the cache, a failed store-to-load forward, and the wrapper's
+// scalar moves were 5 % of embree:packet16's time on Sibenik's tiled rays
+// (docs/notes/embree-packets.md).
 template <int K, typename RayK>
 inline void load_packet(RayK& packet, int* valid, std::span<const Ray> rays) {
+#if defined(__AVX2__)
+  if constexpr (K % 8 == 0) {
+    if (rays.size() == static_cast<std::size_t>(K)) {
+      static_assert(sizeof(Ray) == 8 * sizeof(float));
+      for (int first = 0; first < K; first += 8) {
+        simd::FloatLanes<8> fields[8];  // ox oy oz tnear dx dy dz tfar, lane i: ray first + i
+        simd::FloatLanes<8>::load_transposed8(reinterpret_cast<const float*>(&rays[first]), fields);
+        float* const to[8] = {packet.org_x, packet.org_y, packet.org_z, packet.tnear,
+                              packet.dir_x, packet.dir_y, packet.dir_z, packet.tfar};
+        for (int k = 0; k < 8; ++k) fields[k].storeu(to[k] + first);
+        // -1 where tnear <= tfar (false for NaN, as the scalar test below).
+        _mm256_storeu_ps(reinterpret_cast<float*>(valid + first), _mm256_cmp_ps(fields[3].v, fields[7].v, _CMP_LE_OQ));
+      }
+      return;
+    }
+  }
+#endif
   for (std::size_t i = 0; i < static_cast<std::size_t>(K); ++i) {
     const Ray& r = i < rays.size() ? rays[i] : kEmptyRay;
     packet.org_x[i] = r.org.x, packet.org_y[i] = r.org.y, packet.org_z[i] = r.org.z;
