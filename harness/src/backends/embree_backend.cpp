@@ -379,9 +379,8 @@ void init_packet(RayK& packet) {
 // registers and stored a field at a time (as our packets load theirs,
 // wide_bvh_packet.h): written lane by lane, each field was read by Embree's
 // first 32- or 64-byte load of it while its 8 or 16 stores were still on
-// their way to the cache, a failed store-to-load forward, and the wrapper's
-// scalar moves were 5 % of embree:packet16's time on Sibenik's tiled rays
-// (docs/notes/embree-packets.md).
+// their way to the cache (a failed store-to-load forward; measured:
+// docs/notes/embree-packets.md).
 template <int K, typename RayK>
 inline void load_packet(RayK& packet, int* valid, std::span<const Ray> rays) {
 #if defined(__AVX2__)

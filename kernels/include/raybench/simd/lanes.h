@@ -235,11 +235,10 @@ inline void FloatLanes<8>::load_transposed8(const float* rows, FloatLanes (&out)
   __m256 lo[4], hi[4], tlo[4], thi[4];  // rows 0-3 and 4-7
   // A row as two 16-byte loads into one register: what GCC makes of an
   // unaligned 256-bit load under its AMD tunings anyway, but written so it
-  // stays a register value. From _mm256_loadu_ps, GCC copied the 16 rows of
-  // a 16-ray packet to the stack in 16-byte pieces, and each 32-byte reload
-  // for the shuffles waited for both pieces to reach the cache (a failed
-  // store-to-load forward): Wuson's tiled primary rays 6-9 % slower
-  // (docs/notes/kernels-packets.md).
+  // stays a register value. From _mm256_loadu_ps, GCC copied the rows to
+  // the stack in 16-byte pieces, and each 32-byte reload for the shuffles
+  // waited for both pieces (a failed store-to-load forward; measured:
+  // docs/notes/kernels-packets.md).
   const auto row = [](const float* p) {
     return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p)), _mm_loadu_ps(p + 4), 1);
   };
@@ -371,8 +370,8 @@ struct LanePair {
   // moves the pair as 2H floats of memory, which GCC does in 16-byte pieces
   // where its tuning has no wider moves by pieces (generic, AMD Zen): a
   // register-wide load of such a copy then waits for the pieces to reach
-  // the cache (a failed store-to-load forward), 39 % of the AVX2 packets'
-  // time on Wuson's tiled primary rays (docs/notes/kernels-packets.md).
+  // the cache (a failed store-to-load forward; measured in the AVX2
+  // packets: docs/notes/kernels-packets.md).
   LanePair(const LanePair& o) : lo(o.lo), hi(o.hi) {}
   LanePair& operator=(const LanePair& o) {
     lo = o.lo;
