@@ -387,11 +387,11 @@ inline void load_packet(RayK& packet, int* valid, std::span<const Ray> rays) {
   if constexpr (K % 8 == 0) {
     if (rays.size() == static_cast<std::size_t>(K)) {
       static_assert(sizeof(Ray) == 8 * sizeof(float));
+      float* const to[8] = {packet.org_x, packet.org_y, packet.org_z, packet.tnear,
+                            packet.dir_x, packet.dir_y, packet.dir_z, packet.tfar};  // a Ray's fields in order
       for (int first = 0; first < K; first += 8) {
         simd::FloatLanes<8> fields[8];  // ox oy oz tnear dx dy dz tfar, lane i: ray first + i
         simd::FloatLanes<8>::load_transposed8(reinterpret_cast<const float*>(&rays[first]), fields);
-        float* const to[8] = {packet.org_x, packet.org_y, packet.org_z, packet.tnear,
-                              packet.dir_x, packet.dir_y, packet.dir_z, packet.tfar};
         for (int k = 0; k < 8; ++k) fields[k].storeu(to[k] + first);
         // -1 where tnear <= tfar (false for NaN, as the scalar test below).
         _mm256_storeu_ps(reinterpret_cast<float*>(valid + first), _mm256_cmp_ps(fields[3].v, fields[7].v, _CMP_LE_OQ));
