@@ -303,10 +303,10 @@ TEST(MixedBackends, ATriangleOnlySceneGetsTheTriangleOnlyTree) {
   triangles.obbs.clear();
   ASSERT_FALSE(triangles.has_analytic());
   const std::size_t bvh8_bytes =
-      build_wide_bvh<8, WideMollerTrumbore>(triangles.triangles, Bvh2Builder::kBinnedSah, 0).memory_bytes();
+      build_wide_bvh<8, WideMollerTrumbore>(triangles.triangles, Bvh2Builder::kBinnedSah, Bvh2Reinsertion::kLight).memory_bytes();
   const std::size_t bvh4_bytes =
-      build_wide_bvh<4, WideMollerTrumbore>(triangles.triangles, Bvh2Builder::kBinnedSah, 0).memory_bytes();
-  const Bvh2 bvh2 = build_bvh2(triangles.triangles, Bvh2Builder::kBinnedSah);
+      build_wide_bvh<4, WideMollerTrumbore>(triangles.triangles, Bvh2Builder::kBinnedSah, Bvh2Reinsertion::kLight).memory_bytes();
+  const Bvh2 bvh2 = build_bvh2(triangles.triangles, Bvh2Builder::kBinnedSah, {.reinsertion = Bvh2Reinsertion::kLight});
   const std::size_t bvh2_bytes = bvh2.memory_bytes() + bvh2.prim_ids.size() * sizeof(MollerTrumbore::Prepared);
   const std::vector<Ray> rays = mixed_rays(triangles, 500);
   const std::vector<Ray> traced = screen_rays(rays).rays;  // as a run hands them to every backend (backend.h)

@@ -271,7 +271,7 @@ class Reinserter {
 }  // namespace
 
 std::size_t optimize_bvh2_reinsertion(Bvh2& bvh, const Bvh2ReinsertionOptions& options) {
-  if (bvh.nodes.empty() || bvh.nodes[0].is_leaf() || bvh.prim_ids.empty()) return 0;
+  if (options.passes <= 0 || bvh.nodes.empty() || bvh.nodes[0].is_leaf() || bvh.prim_ids.empty()) return 0;
   Reinserter r(bvh, options.max_depth);
   std::size_t made = 0;
   for (int p = 0; p < options.passes && r.pass(options.batch_fraction, made); ++p) {

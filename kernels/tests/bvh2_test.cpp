@@ -675,7 +675,7 @@ TEST_P(Bvh2Build, ReinsertionLowersTheCostAndKeepsTheLeavesAndEveryInvariant) {
 TEST_P(Bvh2Build, ReinsertedTreesMatchBruteForce) {
   // Through the build option, as the backends ask for it.
   for (int g : {1, 8}) {
-    const Bvh2BuildOptions options{.leaf_granularity = g, .reinsertion_passes = 8};
+    const Bvh2BuildOptions options{.leaf_granularity = g, .reinsertion = Bvh2Reinsertion::kFull};
     const auto mesh = sphere_cluster();
     const Bvh2 bvh = build(mesh, options);
     unsigned seed = 30;
@@ -696,7 +696,7 @@ TEST_P(Bvh2Build, ReinsertionKeepsTheDepthBound) {
     const float x = std::pow(1.3f, -static_cast<float>(i));
     tris.push_back({{x, 0, 0}, {x, x, 0}, {x, 0, x}});
   }
-  const Bvh2BuildOptions shallow{.max_sah_depth = 8, .reinsertion_passes = 8};
+  const Bvh2BuildOptions shallow{.max_sah_depth = 8, .reinsertion = Bvh2Reinsertion::kFull};
   expect_valid(build(tris, shallow), tris, shallow);
   // A tighter bound of its own: no deeper than the tree already was.
   const auto soup = random_soup(5000, 33);
@@ -739,11 +739,38 @@ TEST(Bvh2Reinsertion, RepairsWhatAFastBuildLeft) {
       Bvh2BuildOptions options;
       options.leaf_granularity = g;
       const double lbvh = build_bvh2_lbvh(inputs[i], options).sah_cost(g);
-      options.reinsertion_passes = Bvh2ReinsertionOptions{}.passes;
+      options.reinsertion = Bvh2Reinsertion::kFull;
       EXPECT_LT(build_bvh2(inputs[i], Bvh2Builder::kLbvh, options).sah_cost(g), 0.9 * lbvh)
           << "input " << i << ", leaf granularity " << g;
     }
   }
+}
+
+TEST(Bvh2Reinsertion, TheDefaultBuildsLightBatchLowersTheCostAndTheFullOptimisationMore) {
+  // The backends' default build (Bvh2Reinsertion::kLight: one batch over
+  // the largest nodes) against none and the full optimisation, on the
+  // LBVH trees, which leave the most to move, and on the binned builds.
+  const auto inputs = quality_inputs();
+  for (std::size_t i : {1u, 2u}) {
+    for (Bvh2Builder builder : {Bvh2Builder::kLbvh, Bvh2Builder::kBinnedSah}) {
+      const auto cost = [&](Bvh2Reinsertion r) {
+        return build_bvh2(inputs[i], builder, {.leaf_granularity = 8, .reinsertion = r}).sah_cost(8);
+      };
+      const double none = cost(Bvh2Reinsertion::kNone), light = cost(Bvh2Reinsertion::kLight),
+                   full = cost(Bvh2Reinsertion::kFull);
+      SCOPED_TRACE("input " + std::to_string(i) + ", " + std::string(to_string(builder)));
+      if (builder == Bvh2Builder::kLbvh) {
+        EXPECT_LT(light, 0.99 * none);
+      } else {
+        EXPECT_LE(light, none);
+      }
+      EXPECT_LE(full, light);
+    }
+  }
+  // No pass at all for kNone: the built tree as it is.
+  Bvh2 bvh = build_bvh2_lbvh(inputs[1]);
+  EXPECT_EQ(optimize_bvh2_reinsertion(bvh, Bvh2ReinsertionOptions::of(Bvh2Reinsertion::kNone, 96)), 0u);
+  EXPECT_EQ(Bvh2ReinsertionOptions::of(Bvh2Reinsertion::kLight, 50).max_depth, 50);
 }
 
 TEST(Bvh2Builders, NamesRoundTripAndUnknownNamesAreRejected) {

@@ -353,10 +353,10 @@ TEST(MixedBvh2, EveryPrimitiveIsInOneLeafUnderABoxThatHoldsIt) {
 }
 
 template <typename Tri, typename BoxTest>
-void expect_mixed_bvh2_matches_brute_force(const MixedScene& s, int reinsertion_passes = 0) {
+void expect_mixed_bvh2_matches_brute_force(const MixedScene& s, Bvh2Reinsertion reinsertion = Bvh2Reinsertion::kNone) {
   const PrimitiveSpans p = s.spans();
   Bvh2BuildOptions options;
-  options.reinsertion_passes = reinsertion_passes;
+  options.reinsertion = reinsertion;
   const auto m = build_mixed_bvh2<Tri>(p, options);
   int kinds[4] = {};
   for_each_hard_ray_kind(s, [&](const std::string&, const std::vector<Ray>& rays) {
@@ -376,7 +376,7 @@ TEST(MixedBvh2, EveryHardRayKindMatchesBruteForceWithThePlainBoxTest) {
 }
 
 TEST(MixedBvh2, WatertightTrianglesAndAReinsertedTreeMatchBruteForce) {
-  expect_mixed_bvh2_matches_brute_force<WatertightTriangle, SlabRobust>(mixed_scene(4), /*reinsertion_passes=*/2);
+  expect_mixed_bvh2_matches_brute_force<WatertightTriangle, SlabRobust>(mixed_scene(4), Bvh2Reinsertion::kFull);
 }
 
 TEST(MixedBvh2, ASceneWithoutTrianglesMatchesBruteForce) {
@@ -546,10 +546,10 @@ using ScalarOf = std::conditional_t<std::is_same_v<TriLeaf, WideMollerTrumboreEd
                                                        MollerTrumboreNormal>>;
 
 template <int W, typename TriLeaf, typename BoxTest>
-void expect_mixed_wide_matches_brute_force(const MixedScene& s, int reinsertion_passes = 0) {
+void expect_mixed_wide_matches_brute_force(const MixedScene& s, Bvh2Reinsertion reinsertion = Bvh2Reinsertion::kLight) {
   const PrimitiveSpans p = s.spans();
   SCOPED_TRACE(std::to_string(W) + " wide, " + std::string(BoxTest::name));
-  const MixedWideBvh<W> m = build_mixed_wide_bvh<W, TriLeaf>(p, reinsertion_passes);
+  const MixedWideBvh<W> m = build_mixed_wide_bvh<W, TriLeaf>(p, reinsertion);
   expect_pack_layout<W, TriLeaf>(s, m);
   using Leaf = MixedWideLeaf<TriLeaf>;
   int kinds[4] = {};
@@ -585,8 +585,8 @@ TEST(MixedWideBvh, FourWideMatchesBruteForceWithEachBoxTest) {
 
 TEST(MixedWideBvh, EdgeAndWatertightLeavesAndAReinsertedTreeMatchBruteForce) {
   expect_mixed_wide_matches_brute_force<8, WideMollerTrumboreEdges, SlabFma>(mixed_scene(14));
-  expect_mixed_wide_matches_brute_force<4, WideMollerTrumboreEdges, SlabFma>(mixed_scene(15), /*reinsertion_passes=*/2);
-  expect_mixed_wide_matches_brute_force<8, Bvh8Watertight, SlabRobustRay>(mixed_scene(16), /*reinsertion_passes=*/2);
+  expect_mixed_wide_matches_brute_force<4, WideMollerTrumboreEdges, SlabFma>(mixed_scene(15), Bvh2Reinsertion::kFull);
+  expect_mixed_wide_matches_brute_force<8, Bvh8Watertight, SlabRobustRay>(mixed_scene(16), Bvh2Reinsertion::kFull);
 }
 
 TEST(MixedWideBvh, ASceneWithoutTrianglesMatchesBruteForce) {
@@ -597,7 +597,7 @@ TEST(MixedWideBvh, ASceneWithoutTrianglesMatchesBruteForce) {
 TEST(MixedWideBvh, TheChosenSeedTestsJudgeTheAnalyticPrimitives) {
   const MixedScene s = mixed_scene(19);
   const PrimitiveSpans p = s.spans();
-  const auto m = build_mixed_wide_bvh<8, WideMollerTrumbore>(p, 0, {.sphere_seed = true, .box_seed = true, .obb_seed = true});
+  const auto m = build_mixed_wide_bvh<8, WideMollerTrumbore>(p, Bvh2Reinsertion::kNone, {.sphere_seed = true, .box_seed = true, .obb_seed = true});
   using Leaf = MixedWideLeaf<WideMollerTrumbore>;
   int kinds[4] = {};
   unsigned seed = 400;

@@ -59,7 +59,7 @@ std::vector<Ray> camera_rays(Vec3f eye, int width, int height) {
 
 template <typename Leaf>
 Bvh8 build(const std::vector<Triangle>& tris) {
-  return build_wide_bvh<8, Leaf>(tris, Bvh2Builder::kBinnedSah, 0);
+  return build_wide_bvh<8, Leaf>(tris, Bvh2Builder::kBinnedSah, Bvh2Reinsertion::kLight);
 }
 
 // Shadow rays from the closest hits of `primary`, toward `light`, in the

@@ -76,7 +76,7 @@ std::vector<Ray> every_ray_kind(const std::vector<Triangle>& tris) {
 // Returns how many rays hit (closest hit, through the batch).
 template <int W, typename Leaf, typename BoxTest>
 std::size_t append_answers(const std::vector<Triangle>& tris, const std::vector<Ray>& rays, std::vector<std::uint32_t>& words) {
-  const WideBvh<W> bvh = build_wide_bvh<W, Leaf>(tris, Bvh2Builder::kBinnedSah, 0);
+  const WideBvh<W> bvh = build_wide_bvh<W, Leaf>(tris, Bvh2Builder::kBinnedSah, Bvh2Reinsertion::kLight);
   std::vector<Hit> batch(rays.size());
   std::vector<std::uint8_t> occluded(rays.size());
   intersect_wide_batch<Leaf, BoxTest>(bvh, rays, batch);

@@ -41,7 +41,8 @@ void* build(const raybench_build_input* input, char* error, size_t error_size) {
   try {
     const std::span<const Triangle> triangles(reinterpret_cast<const Triangle*>(input->triangles),
                                               input->triangle_count);
-    return new Bvh(raybench::build_wide_bvh<8, Leaf>(triangles, raybench::Bvh2Builder::kBinnedSah, 0));
+    return new Bvh(raybench::build_wide_bvh<8, Leaf>(triangles, raybench::Bvh2Builder::kBinnedSah,
+                                                     raybench::Bvh2Reinsertion::kLight));
   } catch (const std::bad_alloc&) {
     std::snprintf(error, error_size, "out of memory");
   } catch (const std::exception& e) {

@@ -7,11 +7,8 @@
 
 #include "backends/backend.h"
 #include "io/error.h"
-#include "raybench/bvh/bvh2_reinsertion.h"
 
 namespace raybench {
-
-int BvhOptions::reinsertion_passes() const { return reinsert ? Bvh2ReinsertionOptions{}.passes : 0; }
 
 void append_analytic_seed_names(std::vector<BackendInfo>& out, std::string_view family) {
   const auto add = [&](std::string_view option, std::string_view kernel, std::string_view instead_of, std::string_view what) {

@@ -49,8 +49,9 @@ struct BvhOptions {
   // Traversal with the conservative box test: when 'robust' is named, or
   // with the watertight triangle test unless 'plain_boxes' is named.
   bool robust() const { return robust_boxes.value_or(test == kWatertightTest); }
-  // Bvh2BuildOptions::reinsertion_passes for these options.
-  int reinsertion_passes() const;
+  // Bvh2BuildOptions::reinsertion for these options: the full optimisation
+  // with 'reinsert', else the default build's light batch.
+  Bvh2Reinsertion reinsertion() const { return reinsert ? Bvh2Reinsertion::kFull : Bvh2Reinsertion::kLight; }
 };
 
 struct BackendInfo;

@@ -76,15 +76,15 @@ class MixedBvh2Backend final : public Backend {
 template <int W, typename Leaf, typename BoxTest>
 class MixedWideBvhBackend final : public Backend {
  public:
-  MixedWideBvhBackend(std::string name, Bvh2Builder builder, int reinsertion_passes, AnalyticTestChoice analytic)
-      : name_(std::move(name)), builder_(builder), reinsertion_passes_(reinsertion_passes), analytic_(analytic) {}
+  MixedWideBvhBackend(std::string name, Bvh2Builder builder, Bvh2Reinsertion reinsertion, AnalyticTestChoice analytic)
+      : name_(std::move(name)), builder_(builder), reinsertion_(reinsertion), analytic_(analytic) {}
 
   const std::string& name() const override { return name_; }
 
   void build(const Scene& scene) override {
     require_binned_builder(name_, scene, builder_);
     bvh_ = {};  // the old tree freed first
-    bvh_ = build_mixed_wide_bvh<W, Leaf>(scene.primitives(), reinsertion_passes_, analytic_);
+    bvh_ = build_mixed_wide_bvh<W, Leaf>(scene.primitives(), reinsertion_, analytic_);
   }
 
   std::size_t memory_bytes() const override { return bvh_.memory_bytes(); }
@@ -104,16 +104,16 @@ class MixedWideBvhBackend final : public Backend {
  private:
   std::string name_;
   Bvh2Builder builder_;
-  int reinsertion_passes_;
+  Bvh2Reinsertion reinsertion_;
   AnalyticTestChoice analytic_;
   MixedWideBvh<W> bvh_;
 };
 
 template <int W, typename Leaf>
-std::unique_ptr<Backend> make_wide(bool robust, const std::string& name, Bvh2Builder builder, int reinsertion_passes,
+std::unique_ptr<Backend> make_wide(bool robust, const std::string& name, Bvh2Builder builder, Bvh2Reinsertion reinsertion,
                                    AnalyticTestChoice analytic) {
-  if (robust) return std::make_unique<MixedWideBvhBackend<W, Leaf, SlabRobustRay>>(name, builder, reinsertion_passes, analytic);
-  return std::make_unique<MixedWideBvhBackend<W, Leaf, SlabFma>>(name, builder, reinsertion_passes, analytic);
+  if (robust) return std::make_unique<MixedWideBvhBackend<W, Leaf, SlabRobustRay>>(name, builder, reinsertion, analytic);
+  return std::make_unique<MixedWideBvhBackend<W, Leaf, SlabFma>>(name, builder, reinsertion, analytic);
 }
 
 // The wide backends' triangle leaves.
@@ -121,14 +121,14 @@ enum class MixedWideLeaves { kMollerTrumbore, kMollerTrumboreEdges, kWatertight 
 
 template <int W>
 std::unique_ptr<Backend> make_wide_of_width(MixedWideLeaves leaves, bool robust, const std::string& name,
-                                            Bvh2Builder builder, int reinsertion_passes, AnalyticTestChoice analytic) {
+                                            Bvh2Builder builder, Bvh2Reinsertion reinsertion, AnalyticTestChoice analytic) {
   switch (leaves) {
     case MixedWideLeaves::kMollerTrumbore:
-      return make_wide<W, WideMollerTrumbore>(robust, name, builder, reinsertion_passes, analytic);
+      return make_wide<W, WideMollerTrumbore>(robust, name, builder, reinsertion, analytic);
     case MixedWideLeaves::kMollerTrumboreEdges:
-      return make_wide<W, WideMollerTrumboreEdges>(robust, name, builder, reinsertion_passes, analytic);
+      return make_wide<W, WideMollerTrumboreEdges>(robust, name, builder, reinsertion, analytic);
     case MixedWideLeaves::kWatertight:
-      if constexpr (W == 8) return make_wide<8, Bvh8Watertight>(robust, name, builder, reinsertion_passes, analytic);
+      if constexpr (W == 8) return make_wide<8, Bvh8Watertight>(robust, name, builder, reinsertion, analytic);
       break;
   }
   throw std::logic_error("make_mixed: watertight leaves are 8 wide only");
@@ -190,7 +190,7 @@ std::unique_ptr<Backend> make_mixed(OurBvhFamily family, const std::string& name
   const Bvh2Builder builder = parsed.builder_or_default();
   if (family == OurBvhFamily::kBvh2) {
     Bvh2BuildOptions build_options;
-    build_options.reinsertion_passes = parsed.reinsertion_passes();
+    build_options.reinsertion = parsed.reinsertion();
     const std::string test = parsed.test.value_or(std::string(tests.front()));
     return make_bvh2(name, test, parsed.robust(), builder, build_options, parsed.analytic);
   }
@@ -198,8 +198,8 @@ std::unique_ptr<Backend> make_mixed(OurBvhFamily family, const std::string& name
                                  : parsed.test.value_or("mt") == "mt_edges" ? MixedWideLeaves::kMollerTrumboreEdges
                                                                             : MixedWideLeaves::kMollerTrumbore;
   if (family == OurBvhFamily::kBvh8)
-    return make_wide_of_width<8>(leaves, parsed.robust(), name, builder, parsed.reinsertion_passes(), parsed.analytic);
-  return make_wide_of_width<4>(leaves, parsed.robust(), name, builder, parsed.reinsertion_passes(), parsed.analytic);
+    return make_wide_of_width<8>(leaves, parsed.robust(), name, builder, parsed.reinsertion(), parsed.analytic);
+  return make_wide_of_width<4>(leaves, parsed.robust(), name, builder, parsed.reinsertion(), parsed.analytic);
 }
 
 template <OurBvhFamily F>

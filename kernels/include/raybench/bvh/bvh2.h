@@ -39,6 +39,12 @@ struct Bvh2 {
   double sah_cost(int leaf_granularity = 1) const;
 };
 
+// How much reinsertion optimisation (bvh2_reinsertion.h) follows a build:
+// none; kLight, one batch over the largest nodes, what every backend's
+// default build does (within Embree's medium build time); kFull, the
+// ':reinsert' option's batches, about as long again as the build.
+enum class Bvh2Reinsertion { kNone, kLight, kFull };
+
 struct Bvh2BuildOptions {
   int bin_count = 16;       // SAH bins per axis (Wald 2007, "On fast construction of SAH-based BVHs")
   int max_leaf_size = 8;    // a larger range is always split
@@ -55,9 +61,10 @@ struct Bvh2BuildOptions {
   // SBVH only: spatial splits add at most this fraction of the triangle
   // count in extra references (0.5: prim_ids holds at most 1.5 n entries).
   float spatial_split_budget = 0.5f;
-  // Passes of reinsertion optimisation after the build (bvh2_reinsertion.h),
-  // made by build_bvh2 (bvh2_builders.h) for any builder; 0: none.
-  int reinsertion_passes = 0;
+  // Reinsertion optimisation after the build (bvh2_reinsertion.h), made by
+  // build_bvh2 (bvh2_builders.h) for any builder: none, the default
+  // backends' light batch, or the full optimisation of ':reinsert'.
+  Bvh2Reinsertion reinsertion = Bvh2Reinsertion::kNone;
 };
 
 // Every builder places each triangle in at least one leaf, degenerate ones

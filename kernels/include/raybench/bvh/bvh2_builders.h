@@ -65,9 +65,9 @@ constexpr std::optional<Bvh2Builder> parse_bvh2_builder(std::string_view name) {
   return std::nullopt;
 }
 
-// The backend option that optimises the built tree by reinsertion
-// ("bvh2:reinsert", "bvh8:sweep:reinsert"): Bvh2BuildOptions::reinsertion_passes
-// = Bvh2ReinsertionOptions{}.passes.
+// The backend option that optimises the built tree fully by reinsertion
+// ("bvh2:reinsert", "bvh8:sweep:reinsert"): Bvh2Reinsertion::kFull instead
+// of the default build's kLight.
 inline constexpr std::string_view kReinsertOption = "reinsert";
 
 // Whether a backend option changes only the tree (a builder, or reinsertion),
@@ -83,8 +83,8 @@ inline std::string bvh2_builder_names() {
   return out;
 }
 
-// The tree of `builder`, then options.reinsertion_passes passes of
-// reinsertion optimisation (bvh2_reinsertion.h), within the same depth bound.
+// The tree of `builder`, then options.reinsertion's reinsertion
+// optimisation (bvh2_reinsertion.h), within the same depth bound.
 inline Bvh2 build_bvh2(std::span<const Triangle> triangles, Bvh2Builder builder, const Bvh2BuildOptions& options = {}) {
   Bvh2 bvh = [&] {
     switch (builder) {
@@ -95,8 +95,7 @@ inline Bvh2 build_bvh2(std::span<const Triangle> triangles, Bvh2Builder builder,
     }
     return build_bvh2_binned_sah(triangles, options);
   }();
-  if (options.reinsertion_passes > 0)
-    optimize_bvh2_reinsertion(bvh, {.passes = options.reinsertion_passes, .max_depth = options.max_sah_depth + 32});
+  optimize_bvh2_reinsertion(bvh, Bvh2ReinsertionOptions::of(options.reinsertion, options.max_sah_depth + 32));
   return bvh;
 }
 

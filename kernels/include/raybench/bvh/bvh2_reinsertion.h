@@ -14,11 +14,26 @@
 namespace raybench {
 
 struct Bvh2ReinsertionOptions {
-  // 8 batches of 5 %: about a quarter lower SAH cost than the binned build,
-  // for about as much build time again (measured: docs/notes/kernels-builders.md).
+  // 8 batches of 5 % (Bvh2Reinsertion::kFull): about a quarter lower SAH
+  // cost than the binned build, for about as much build time again
+  // (measured: docs/notes/kernels-builders.md).
   int passes = 8;                // batches; fewer when a batch improves nothing
   float batch_fraction = 0.05f;  // the nodes of largest area tried per batch, as a fraction of all nodes
   int max_depth = 96;            // no reinsertion makes the tree deeper (Bvh2BuildOptions::max_sah_depth + 32)
+
+  // The options of a level, within max_depth: kNone makes no pass. kLight
+  // is one batch of the 2 % largest nodes: the moves high in the tree,
+  // where most of the cost is, for a few per cent of the binned build's
+  // time, most of what more batches gain on the architectural interiors
+  // (measured: docs/notes/kernels-builders.md).
+  static Bvh2ReinsertionOptions of(Bvh2Reinsertion level, int max_depth) {
+    switch (level) {
+      case Bvh2Reinsertion::kNone: return {.passes = 0, .max_depth = max_depth};
+      case Bvh2Reinsertion::kLight: return {.passes = 1, .batch_fraction = 0.02f, .max_depth = max_depth};
+      case Bvh2Reinsertion::kFull: break;
+    }
+    return {.max_depth = max_depth};
+  }
 };
 
 // Moves subtrees (a leaf or an inner node with everything below it) of `bvh`

@@ -45,7 +45,7 @@ struct MixedBvh2 {
 };
 
 // The tree over every primitive of `prims` (binned SAH over their boxes,
-// then options.reinsertion_passes of reinsertion), its leaves judged by Test
+// then options.reinsertion's reinsertion), its leaves judged by Test
 // and the analytic tests `tests`. Throws std::length_error for more than
 // kMaxMixedPrimsPerKind primitives of one kind.
 template <typename Test>
@@ -55,8 +55,7 @@ MixedBvh2<Test> build_mixed_bvh2(const PrimitiveSpans& prims, const Bvh2BuildOpt
     if (n > kMaxMixedPrimsPerKind) throw std::length_error("build_mixed_bvh2: too many primitives of one kind");
   MixedBvh2<Test> m;
   m.bvh = build_bvh2_binned_sah(std::span<const BBox>(primitive_bounds(prims)), options);
-  if (options.reinsertion_passes > 0)
-    optimize_bvh2_reinsertion(m.bvh, {.passes = options.reinsertion_passes, .max_depth = options.max_sah_depth + 32});
+  optimize_bvh2_reinsertion(m.bvh, Bvh2ReinsertionOptions::of(options.reinsertion, options.max_sah_depth + 32));
   m.analytic.tests = tests;
   m.refs.reserve(m.bvh.prim_ids.size());
   m.triangles.reserve(prims.triangles.size());

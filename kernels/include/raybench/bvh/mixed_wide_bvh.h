@@ -137,24 +137,23 @@ inline Triangle mixed_stand_in(const BBox& b) { return {b.lower, b.upper, {b.low
 // The wide tree over every primitive of `prims` for TriangleLeaf's triangle
 // packs, built as build_wide_bvh (wide_bvh_batch.h) builds the triangle-only
 // tree with the binned SAH builder: leaves of up to W primitives (the SAH
-// counting them in packs of W), or with reinsertion_passes > 0 leaves of
+// counting them in packs of W), or with the full reinsertion leaves of
 // single primitives gathered by the collapse, in occlusion lane order.
 // Throws std::length_error for more than kMaxMixedPrimsPerKind primitives of
 // one kind.
 template <int W, typename TriangleLeaf>
-MixedWideBvh<W> build_mixed_wide_bvh(const PrimitiveSpans& prims, int reinsertion_passes = 0,
+MixedWideBvh<W> build_mixed_wide_bvh(const PrimitiveSpans& prims, Bvh2Reinsertion reinsertion = Bvh2Reinsertion::kNone,
                                      AnalyticTestChoice tests = {}) {
   for (std::size_t n : {prims.triangles.size(), prims.spheres.size(), prims.boxes.size(), prims.obbs.size()})
     if (n > kMaxMixedPrimsPerKind) throw std::length_error("build_mixed_wide_bvh: too many primitives of one kind");
-  const bool quality = reinsertion_passes > 0;
+  const bool quality = reinsertion == Bvh2Reinsertion::kFull;
   Bvh2BuildOptions options;
   options.leaf_granularity = quality ? 1 : W;
   options.max_leaf_size = W;  // a BVH2 leaf fits one pack
-  options.reinsertion_passes = reinsertion_passes;
+  options.reinsertion = reinsertion;
   const HugePageVector<BBox> bounds = primitive_bounds(prims);
   Bvh2 bvh2 = build_bvh2_binned_sah(std::span<const BBox>(bounds), options);
-  if (reinsertion_passes > 0)
-    optimize_bvh2_reinsertion(bvh2, {.passes = reinsertion_passes, .max_depth = options.max_sah_depth + 32});
+  optimize_bvh2_reinsertion(bvh2, Bvh2ReinsertionOptions::of(reinsertion, options.max_sah_depth + 32));
 
   // Filled on every thread, never zeroed first (as primitive_bounds).
   HugePageVector<Triangle> stand_ins;

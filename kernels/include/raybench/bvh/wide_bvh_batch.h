@@ -13,10 +13,10 @@
 
 namespace raybench {
 
-// A BVH2 built by `builder` (with `reinsertion_passes` of reinsertion),
-// collapsed to W-wide nodes with the leaves `Leaf` traverses.
+// A BVH2 built by `builder` (then optimised by `reinsertion`), collapsed
+// to W-wide nodes with the leaves `Leaf` traverses.
 template <int W, typename Leaf>
-WideBvh<W> build_wide_bvh(std::span<const Triangle> triangles, Bvh2Builder builder, int reinsertion_passes) {
+WideBvh<W> build_wide_bvh(std::span<const Triangle> triangles, Bvh2Builder builder, Bvh2Reinsertion reinsertion) {
   Bvh2BuildOptions options;
   // The quality builds (spatial splits, reinsertion) build the BVH2 with
   // small leaves, scored as scalar tests: the collapse then gathers subtrees
@@ -24,11 +24,11 @@ WideBvh<W> build_wide_bvh(std::span<const Triangle> triangles, Bvh2Builder build
   // (wide_bvh_collapse.cpp), which fills nodes better. Measured on Sponza:
   // 4-10 % more rays/s, for 1.8x the build time. The default build keeps
   // leaves of up to W triangles (the SAH counts them in packs of W), as
-  // fast to build as Embree's medium build.
-  const bool quality = builder == Bvh2Builder::kSbvh || reinsertion_passes > 0;
+  // fast to build as Embree's medium build (its light reinsertion too).
+  const bool quality = builder == Bvh2Builder::kSbvh || reinsertion == Bvh2Reinsertion::kFull;
   options.leaf_granularity = quality ? 1 : W;
   options.max_leaf_size = W;  // a BVH2 leaf fits one pack
-  options.reinsertion_passes = reinsertion_passes;
+  options.reinsertion = reinsertion;
   // Any-hit traversal visits the children in lane order: the smallest box
   // first for the default build, the most likely to end the ray per cost
   // first for the quality builds (WideLaneOrder::kOcclusion).
