@@ -15,6 +15,8 @@
 #include "scene/scene.h"
 #include "test_util.h"
 #include "measure/trace.h"
+#include "raybench/bvh/bvh2_builders.h"
+#include "raybench/bvh/wide_bvh_batch.h"
 #include "raybench/variants.h"
 
 namespace raybench {
@@ -494,6 +496,31 @@ TEST(Builders, OurBackendsReportTheSahCostOfTheirTreeAndEmbreeNone) {
   EXPECT_LE(cost("bvh2:sbvh"), cost("bvh2") * 1.005);
   EXPECT_LE(cost("bvh2:reinsert"), cost("bvh2"));
   EXPECT_LT(cost("bvh2:lbvh:reinsert"), cost("bvh2:lbvh"));
+}
+
+TEST(Builders, TheDefaultBuildMakesOneReinsertionBatchAndReinsertTheFullOptimisation) {
+  // The backends' trees are the kernels' builds at the level their names
+  // ask for: Bvh2Reinsertion::kLight without 'reinsert', kFull with it
+  // (docs/backends.md, "Options: builders and reinsertion").
+  const Scene scene = load_scene("proc:terrain_spheres_small");
+  const auto cost = [&](const std::string& name) {
+    const auto backend = make_backend(name);
+    backend->build(scene);
+    return backend->sah_cost();
+  };
+  const auto bvh2_cost = [&](Bvh2Reinsertion r) {
+    return build_bvh2(scene.triangles, Bvh2Builder::kBinnedSah, {.reinsertion = r}).sah_cost();
+  };
+  const auto bvh8_cost = [&](Bvh2Reinsertion r) {
+    return build_wide_bvh<8, WideMollerTrumbore>(scene.triangles, Bvh2Builder::kBinnedSah, r).sah_cost();
+  };
+  EXPECT_EQ(cost("bvh2"), bvh2_cost(Bvh2Reinsertion::kLight));
+  EXPECT_EQ(cost("bvh2:reinsert"), bvh2_cost(Bvh2Reinsertion::kFull));
+  EXPECT_EQ(cost("bvh8"), bvh8_cost(Bvh2Reinsertion::kLight));
+  EXPECT_EQ(cost("bvh8:reinsert"), bvh8_cost(Bvh2Reinsertion::kFull));
+  // On this scene the batch moves something: the default is not the bare build.
+  EXPECT_LT(bvh2_cost(Bvh2Reinsertion::kLight), bvh2_cost(Bvh2Reinsertion::kNone));
+  EXPECT_NE(bvh8_cost(Bvh2Reinsertion::kLight), bvh8_cost(Bvh2Reinsertion::kNone));
 }
 
 }  // namespace
