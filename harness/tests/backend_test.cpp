@@ -471,13 +471,16 @@ TEST(Builders, EveryBuilderGivesTheSameHitsAsTheDefaultBuild) {
   }
 }
 
+// The sah_cost backend `name` reports for its tree of `scene`.
+double sah_cost_of(const std::string& name, const Scene& scene) {
+  const auto backend = make_backend(name);
+  backend->build(scene);
+  return backend->sah_cost();
+}
+
 TEST(Builders, OurBackendsReportTheSahCostOfTheirTreeAndEmbreeNone) {
   const Scene scene = load_scene("proc:terrain_spheres_small");
-  const auto cost = [&](const std::string& name) {
-    const auto backend = make_backend(name);
-    backend->build(scene);
-    return backend->sah_cost();
-  };
+  const auto cost = [&](const std::string& name) { return sah_cost_of(name, scene); };
   for (const char* name : {"bvh2", "bvh2:sweep", "bvh2:lbvh", "bvh2:sbvh", "bvh2:reinsert", "bvh8", "bvh8:sweep",
                            "bvh8:lbvh", "bvh8:sbvh", "bvh8:reinsert"}) {
     EXPECT_TRUE(std::isfinite(cost(name))) << name;
@@ -503,11 +506,7 @@ TEST(Builders, TheDefaultBuildMakesOneReinsertionBatchAndReinsertTheFullOptimisa
   // ask for: Bvh2Reinsertion::kLight without 'reinsert', kFull with it
   // (docs/backends.md, "Options: builders and reinsertion").
   const Scene scene = load_scene("proc:terrain_spheres_small");
-  const auto cost = [&](const std::string& name) {
-    const auto backend = make_backend(name);
-    backend->build(scene);
-    return backend->sah_cost();
-  };
+  const auto cost = [&](const std::string& name) { return sah_cost_of(name, scene); };
   const auto bvh2_cost = [&](Bvh2Reinsertion r) {
     return build_bvh2(scene.triangles, Bvh2Builder::kBinnedSah, {.reinsertion = r}).sah_cost();
   };
