@@ -95,7 +95,7 @@ inline Bvh2 build_bvh2(std::span<const Triangle> triangles, Bvh2Builder builder,
     }
     return build_bvh2_binned_sah(triangles, options);
   }();
-  optimize_bvh2_reinsertion(bvh, Bvh2ReinsertionOptions::of(options.reinsertion, options.max_sah_depth + 32));
+  optimize_bvh2_after_build(bvh, options);
   return bvh;
 }
 

@@ -48,4 +48,11 @@ struct Bvh2ReinsertionOptions {
 // depends only on the input tree. Returns the number of moves made.
 std::size_t optimize_bvh2_reinsertion(Bvh2& bvh, const Bvh2ReinsertionOptions& options = {});
 
+// The reinsertion a build's options ask for (options.reinsertion), within
+// that build's depth bound (max_sah_depth + 32, as every builder keeps it):
+// what build_bvh2 and the mixed trees' builds do after building.
+inline std::size_t optimize_bvh2_after_build(Bvh2& bvh, const Bvh2BuildOptions& options) {
+  return optimize_bvh2_reinsertion(bvh, Bvh2ReinsertionOptions::of(options.reinsertion, options.max_sah_depth + 32));
+}
+
 }  // namespace raybench

@@ -55,7 +55,7 @@ MixedBvh2<Test> build_mixed_bvh2(const PrimitiveSpans& prims, const Bvh2BuildOpt
     if (n > kMaxMixedPrimsPerKind) throw std::length_error("build_mixed_bvh2: too many primitives of one kind");
   MixedBvh2<Test> m;
   m.bvh = build_bvh2_binned_sah(std::span<const BBox>(primitive_bounds(prims)), options);
-  optimize_bvh2_reinsertion(m.bvh, Bvh2ReinsertionOptions::of(options.reinsertion, options.max_sah_depth + 32));
+  optimize_bvh2_after_build(m.bvh, options);
   m.analytic.tests = tests;
   m.refs.reserve(m.bvh.prim_ids.size());
   m.triangles.reserve(prims.triangles.size());

@@ -153,7 +153,7 @@ MixedWideBvh<W> build_mixed_wide_bvh(const PrimitiveSpans& prims, Bvh2Reinsertio
   options.reinsertion = reinsertion;
   const HugePageVector<BBox> bounds = primitive_bounds(prims);
   Bvh2 bvh2 = build_bvh2_binned_sah(std::span<const BBox>(bounds), options);
-  optimize_bvh2_reinsertion(bvh2, Bvh2ReinsertionOptions::of(reinsertion, options.max_sah_depth + 32));
+  optimize_bvh2_after_build(bvh2, options);
 
   // Filled on every thread, never zeroed first (as primitive_bounds).
   HugePageVector<Triangle> stand_ins;
