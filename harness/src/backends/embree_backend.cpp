@@ -55,6 +55,7 @@
 #include "io/command_output.h"
 #include "backends/embree_selection.h"
 #include "io/error.h"
+#include "raybench/math/prefetch.h"
 #include "raybench/prim/aabb_slab.h"
 #include "raybench/prim/analytic_hit.h"
 #include "raybench/prim/obb_eigen.h"
@@ -602,6 +603,7 @@ class EmbreeBackend final : public Backend {
     for (std::size_t first = 0; first < rays.size(); first += K) {
       const std::size_t lanes = std::min<std::size_t>(K, rays.size() - first);
       load_packet<K>(packet.ray, valid, rays.subspan(first, lanes));
+      prefetch_rays(rays, first + K, K);  // the next packet's, as our packets do (wide_bvh_packet.h)
       for (int i = 0; i < K; ++i) packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
       Packet<K>::intersect(valid, scene_, &context, &packet);
       for (std::size_t i = 0; i < lanes; ++i)
@@ -619,6 +621,7 @@ class EmbreeBackend final : public Backend {
     for (std::size_t first = 0; first < rays.size(); first += K) {
       const std::size_t lanes = std::min<std::size_t>(K, rays.size() - first);
       load_packet<K>(packet, valid, rays.subspan(first, lanes));
+      prefetch_rays(rays, first + K, K);
       Packet<K>::occluded(valid, scene_, &context, &packet);
       // As occluded(): "occluded" lowers tfar to -inf; a lane Embree did not trace keeps its tfar.
       for (std::size_t i = 0; i < lanes; ++i) occluded[first + i] = packet.tfar[i] < rays[first + i].tfar;

@@ -47,6 +47,7 @@
 
 #include "raybench/bvh/wide_bvh_batch.h"
 #include "raybench/bvh/wide_bvh_traverse.h"
+#include "raybench/math/prefetch.h"
 
 namespace raybench {
 
@@ -194,14 +195,6 @@ template <typename Half, int H>
 inline F8 fold_min(simd::LanePair<Half, H> x) { return fold_min(min(x.lo, x.hi)); }
 template <typename Half, int H>
 inline F8 fold_max(simd::LanePair<Half, H> x) { return fold_max(max(x.lo, x.hi)); }
-
-// Asks for every 64-byte cache line of `x` ahead of its use: a hint, it
-// changes no result.
-template <typename T>
-inline void prefetch_lines(const T& x) {
-  const char* bytes = reinterpret_cast<const char*>(&x);
-  for (std::size_t line = 0; line < sizeof(T); line += 64) __builtin_prefetch(bytes + line);
-}
 
 // Among the rays `candidates` of a group loaded into `p` (load_group), the
 // packet led by the first: those that share its octant, point within
@@ -673,6 +666,7 @@ void trace_groups(const Bvh8& bvh, std::span<const Ray> rays, float max_origin_d
                   InPacket&& in_packet) {
   for (std::size_t first = 0; first < rays.size(); first += kPacketRays) {
     const int n = static_cast<int>(std::min<std::size_t>(kPacketRays, rays.size() - first));
+    prefetch_rays(rays, first + kPacketRays, kPacketRays);  // the next group's, read after this one's traversal
     Packet p;
     const unsigned left = plan_group(&rays[first], n, max_origin_distance, bvh.bounds, p,
                                      [&](const Packet& packet, PacketPlan plan) { in_packet(first, packet, plan); });
