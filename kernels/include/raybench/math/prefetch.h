@@ -27,7 +27,7 @@ inline void prefetch_lines(const T& x) {
 // batch loop reads next. A loop that traces a packet (or one ray) between
 // its reads of the ray array leaves the hardware's stream prefetcher
 // behind; asking for the next packet's rays while tracing this one hides
-// their load (docs/notes/kernels-packets.md, "prefetching the next rays").
+// their load (docs/notes/kernels-packets.md, "the next group's rays prefetched").
 inline void prefetch_rays(std::span<const Ray> rays, std::size_t first, std::size_t count) {
   if (first >= rays.size()) return;
   prefetch_bytes(&rays[first], std::min(count, rays.size() - first) * sizeof(Ray));
