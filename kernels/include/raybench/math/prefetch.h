@@ -5,16 +5,23 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <span>
 
 #include "raybench/math/ray.h"
 
 namespace raybench {
 
-// Every 64-byte cache line of the `bytes` bytes from `p`.
+// Every 64-byte cache line that holds some of the `bytes` bytes from `p`,
+// counted from the line of the first byte: a range that starts inside a
+// line (rays of 32 bytes from a 16-byte-aligned array) also gets its last
+// line.
 inline void prefetch_bytes(const void* p, std::size_t bytes) {
-  const char* first = static_cast<const char*>(p);
-  for (std::size_t line = 0; line < bytes; line += 64) __builtin_prefetch(first + line);
+  if (bytes == 0) return;
+  const std::uintptr_t begin = reinterpret_cast<std::uintptr_t>(p);
+  const std::uintptr_t end = begin + bytes;
+  for (std::uintptr_t line = begin & ~std::uintptr_t{63}; line < end; line += 64)
+    __builtin_prefetch(reinterpret_cast<const void*>(line));
 }
 
 // Every cache line of `x` (a node, a pack of triangles).
